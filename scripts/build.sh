@@ -1,0 +1,7 @@
+#!/usr/bin/env bash
+# Installs missing Debian packages and builds the release preset (library, CLI, studio, tests).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake --preset release >/dev/null
+cmake --build --preset release -j "$(nproc)"
