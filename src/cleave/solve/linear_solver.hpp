@@ -1,0 +1,53 @@
+#pragma once
+// Solvers take operators, not models: a symmetric positive (semi-)definite sparse matrix on the
+// vertex degrees of freedom of a linked volume (dof 3 * vertex + axis), plus that volume for the
+// geometric multigrid. Fixed (Dirichlet) dofs arrive already eliminated: their row and column are
+// zero except a 1 on the diagonal, and their right-hand side entry holds the prescribed value.
+#include <Eigen/Sparse>
+#include <memory>
+#include <string>
+#include <string_view>
+
+#include "cleave/grid/linked_volume.hpp"
+
+namespace cleave {
+
+using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
+using Vector = Eigen::VectorXd;
+
+enum class SolverKind {
+  multigrid_cg,  ///< cleave's default: CG preconditioned by a cut-aware geometric multigrid V-cycle
+  eigen_cg,      ///< peer: Eigen's ConjugateGradient with incomplete Cholesky
+  cholmod,       ///< peer: SuiteSparse CHOLMOD sparse Cholesky (direct)
+};
+
+/// "multigrid", "eigen-cg", "cholmod" <-> SolverKind. Throws InputError listing the names.
+SolverKind solver_kind_from_name(std::string_view name);
+std::string_view solver_kind_name(SolverKind kind);
+
+struct SolveSettings {
+  double relative_tolerance = 1e-8;  ///< stop when ||b - A x|| <= tol * ||b||
+  int max_iterations = 2000;
+};
+
+struct SolveReport {
+  int iterations = 0;
+  double relative_residual = 0;  ///< ||b - A x|| / ||b|| reached
+  bool converged = false;
+};
+
+class LinearSolver {
+ public:
+  virtual ~LinearSolver() = default;
+  /// Prepares for A (factorization, hierarchy). `topology` is the linked volume whose vertices
+  /// the dofs belong to; it must stay alive and unchanged until the next setup.
+  virtual void setup(const SparseMatrix& a, const LinkedVolume& topology) = 0;
+  /// Solves A x = b; x holds the initial guess on entry (warm start) and the solution on exit.
+  /// Never leaves NaN in x: on divergence x keeps its last finite iterate and converged = false.
+  virtual SolveReport solve(const Vector& b, Vector& x) = 0;
+  virtual std::string_view name() const = 0;
+};
+
+std::unique_ptr<LinearSolver> make_linear_solver(SolverKind kind, const SolveSettings& settings = {});
+
+}  // namespace cleave
