@@ -1,6 +1,8 @@
 #include "cleave/io/case_file.hpp"
 
+#include <cmath>
 #include <fmt/format.h>
+#include <limits>
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/atomic_file.hpp"
@@ -60,9 +62,15 @@ void parse_materials(const nlohmann::json& materials, const JsonPath& at, CaseFi
     Material m;
     m.name = "label " + key;
     if (const auto* n = json_find(value, "name")) m.name = json_string(*n, here / "name");
-    if (const auto* e = json_find(value, "E_kPa")) m.youngs_modulus_kPa = json_number(*e, here / "E_kPa");
-    if (const auto* nu = json_find(value, "nu")) m.poisson_ratio = json_number(*nu, here / "nu");
-    if (const auto* d = json_find(value, "density_kg_per_m3")) m.density_kg_per_m3 = json_number(*d, here / "density_kg_per_m3");
+    constexpr double kInf = std::numeric_limits<double>::infinity();
+    constexpr double kSmallest = std::numeric_limits<double>::min();
+    if (const auto* e = json_find(value, "E_kPa"))
+      m.youngs_modulus_kPa = json_number_in(*e, here / "E_kPa", kSmallest, kInf, "a positive Young's modulus in kPa");
+    if (const auto* nu = json_find(value, "nu"))
+      m.poisson_ratio = json_number_in(*nu, here / "nu", std::nextafter(-1.0, 0.0), std::nextafter(0.5, 0.0),
+                                       "a Poisson ratio in (-1, 0.5)");
+    if (const auto* d = json_find(value, "density_kg_per_m3"))
+      m.density_kg_per_m3 = json_number_in(*d, here / "density_kg_per_m3", kSmallest, kInf, "a positive density in kg/m^3");
     validate_material(m, here.str());
     out.materials[static_cast<Label>(label)] = m;
   }
