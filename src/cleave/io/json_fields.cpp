@@ -109,6 +109,12 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& file)
     const auto colon = reason.find("syntax error");
     if (colon != std::string::npos) reason = reason.substr(colon);
     throw InputError(fmt::format("{}: invalid JSON at byte {}: {}", file, e.byte, reason));
+  } catch (const nlohmann::json::exception& e) {
+    // e.g. out_of_range.406 "number overflow parsing '1e999'"
+    std::string reason = e.what();
+    const auto bracket = reason.find("] ");
+    if (bracket != std::string::npos) reason = reason.substr(bracket + 2);
+    throw InputError(fmt::format("{}: invalid JSON: {}", file, reason));
   }
 }
 

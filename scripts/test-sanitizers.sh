@@ -1,0 +1,11 @@
+#!/usr/bin/env bash
+# Builds the library and the C++ tests with ASan + UBSan (preset `asan`) and runs them.
+# Browser tests are left to the release pass (they exercise the same server code through the CLI).
+set -euo pipefail
+cd "$(dirname "$0")/.."
+scripts/install-deps.sh
+cmake --preset asan >/dev/null
+cmake --build --preset asan -j "$(nproc)"
+export ASAN_OPTIONS=detect_leaks=1:abort_on_error=1:strict_string_checks=1
+export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
+ctest --preset asan --label-exclude browser "$@"
