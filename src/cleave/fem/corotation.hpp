@@ -1,0 +1,27 @@
+#pragma once
+// Corotational frames of the cells: the rotation R of each cell from the deformation gradient F
+// at its centre, by polar decomposition F = R S (R proper orthogonal, S symmetric).
+#include <vector>
+
+#include "cleave/fem/hex8_element.hpp"
+#include "cleave/grid/linked_volume.hpp"
+#include "cleave/solve/linear_solver.hpp"
+
+namespace cleave {
+
+/// The rotation of F = R S (via SVD; det R = +1 also for an inverted F, where the axis of the
+/// smallest singular value is flipped). Identity for F = I.
+Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
+
+/// R per cell for vertex displacements `u` (3 n_v, mm); computed in parallel.
+void cell_rotations(const LinkedVolume& volume, const Vector& displacement_mm, std::vector<Mat3>& rotations);
+
+/// The 24 nodal displacements of cell c gathered from `u` (3 n_v).
+Vec24 cell_displacement(const LinkedVolume& volume, CellId c, const Vector& displacement_mm);
+
+/// Corotated element displacement R^T x_e - X_e (24, mm) of a cell with rotation R: the nodal
+/// positions x = X + u brought back into the cell's reference frame, relative to node 0 (K^e and
+/// T^e do not see translations).
+Vec24 corotated_displacement(const Vec24& cell_displacement_mm, const Mat3& rotation, double h_mm);
+
+}  // namespace cleave

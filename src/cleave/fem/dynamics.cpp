@@ -1,0 +1,211 @@
+#include "cleave/fem/dynamics.hpp"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include "cleave/core/error.hpp"
+#include "cleave/fem/corotation.hpp"
+#include "cleave/fem/fixed_dofs.hpp"
+#include "cleave/fem/lumped_mass.hpp"
+#include "cleave/fem/solve_static.hpp"
+#include "cleave/fem/vertex_block_matrix.hpp"
+
+namespace cleave {
+
+Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_kPa, DynamicsSettings settings)
+    : model_(model), stress_kPa_(std::move(residual_stress_kPa)), settings_(std::move(settings)) {
+  const LinkedVolume& volume = model_.volume;
+  if (!stress_kPa_.empty() && stress_kPa_.size() != static_cast<std::size_t>(volume.cell_count()))
+    throw InputError(fmt::format("residual stress holds {} cell tensors; expected one per cell ({})", stress_kPa_.size(),
+                                 volume.cell_count()));
+  if (!(settings_.mass_damping_per_s >= 0) || !(settings_.stiffness_damping_s >= 0))
+    throw InputError(fmt::format("damping is alpha {} 1/s, beta {} s; expected non-negative numbers",
+                                 settings_.mass_damping_per_s, settings_.stiffness_damping_s));
+  const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
+  if (settings_.external_force_mN.size() != 0 && settings_.external_force_mN.size() != dofs)
+    throw InputError(fmt::format("external force holds {} values; expected {} (3 per vertex)", settings_.external_force_mN.size(), dofs));
+  table_ = make_element_table(model_);
+  solver_ = make_linear_solver(settings_.solver, settings_.solve);
+  const FixedDofs held = fix_vertices(volume.vertex_count(), settings_.fixed_vertices);
+  fixed_ = held.fixed;
+  u_ = Vector::Zero(dofs);
+  v_ = Vector::Zero(dofs);
+  a_ = Vector::Zero(dofs);
+  rebuild_topology();
+  compute_acceleration();
+}
+
+Dynamics::~Dynamics() = default;
+
+std::string_view Dynamics::solver_name() const { return solver_->name(); }
+
+void Dynamics::rebuild_topology() {
+  mass_ = lumped_mass(model_, table_);
+  stiffness_ = make_vertex_block_pattern(model_.volume);
+  update_rotations();
+}
+
+void Dynamics::update_rotations() { cell_rotations(model_.volume, u_, rotations_); }
+
+void Dynamics::topology_changed(const CutReport& report) {
+  const LinkedVolume& volume = model_.volume;
+  const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
+  const Eigen::Index old = u_.size();
+  u_.conservativeResize(dofs);
+  v_.conservativeResize(dofs);
+  a_.conservativeResize(dofs);
+  fixed_.resize(static_cast<std::size_t>(dofs), 0);
+  if (settings_.external_force_mN.size() != 0) {
+    settings_.external_force_mN.conservativeResize(dofs);
+    settings_.external_force_mN.tail(dofs - old).setZero();
+  }
+  for (const VertexSplit& split : report.splits)
+    for (const VertexId v : split.created) {
+      u_.segment<3>(3 * v) = u_.segment<3>(3 * split.original);
+      v_.segment<3>(3 * v) = v_.segment<3>(3 * split.original);
+      a_.segment<3>(3 * v) = a_.segment<3>(3 * split.original);
+      for (int i = 0; i < 3; ++i)
+        fixed_[static_cast<std::size_t>(3 * v + i)] = fixed_[static_cast<std::size_t>(3 * split.original + i)];
+    }
+  rebuild_topology();
+}
+
+void Dynamics::set_state(const Vector& displacement_mm, const Vector& velocity_mm_per_s) {
+  if (displacement_mm.size() != u_.size() || velocity_mm_per_s.size() != u_.size())
+    throw InputError(fmt::format("state holds {} and {} values; expected {} (3 per vertex)", displacement_mm.size(),
+                                 velocity_mm_per_s.size(), u_.size()));
+  u_ = displacement_mm;
+  v_ = velocity_mm_per_s;
+  update_rotations();
+  compute_acceleration();
+}
+
+std::vector<Vec3> Dynamics::displacement_mm() const {
+  std::vector<Vec3> out(static_cast<std::size_t>(u_.size() / 3));
+  for (std::size_t v = 0; v < out.size(); ++v) out[v] = u_.segment<3>(3 * static_cast<Eigen::Index>(v));
+  return out;
+}
+
+Vector Dynamics::internal_forces() const {
+  const LinkedVolume& volume = model_.volume;
+  const double h = table_.cell_size_mm;
+  std::vector<Vec24> per_cell(static_cast<std::size_t>(volume.cell_count()));
+  tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
+    for (CellId c = r.begin(); c != r.end(); ++c) {
+      const auto ci = static_cast<std::size_t>(c);
+      const Mat3& rot = rotations_[ci];
+      Vec24 local = table_.of_label(volume.cell_label(c)).stiffness * corotated_displacement(cell_displacement(volume, c, u_), rot, h);
+      if (!stress_kPa_.empty()) local += table_.stress_divergence * stress_kPa_[ci];
+      for (int a = 0; a < kCornerCount; ++a) per_cell[ci].segment<3>(3 * a) = rot * local.segment<3>(3 * a);
+    }
+  });
+  Vector f = Vector::Zero(u_.size());
+  for (CellId c = 0; c < volume.cell_count(); ++c) {
+    const auto& corners = volume.cell_vertices(c);
+    for (int a = 0; a < kCornerCount; ++a)
+      f.segment<3>(3 * corners[static_cast<std::size_t>(a)]) += per_cell[static_cast<std::size_t>(c)].segment<3>(3 * a);
+  }
+  return f;
+}
+
+Vector Dynamics::external_forces() const {
+  Vector f = Vector::Zero(u_.size());
+  if (settings_.external_force_mN.size() != 0) f += settings_.external_force_mN;
+  if (!settings_.gravity_mm_per_s2.isZero())
+    for (Eigen::Index i = 0; i < f.size(); ++i) f[i] += mass_[i] * settings_.gravity_mm_per_s2[i % 3];
+  return f;
+}
+
+void Dynamics::assemble_rotated_stiffness() {
+  const LinkedVolume& volume = model_.volume;
+  volume.vertex_cells();
+  const auto block = [&](CellId c, int a, int b) -> Mat3 {
+    const Mat3& r = rotations_[static_cast<std::size_t>(c)];
+    return r * table_.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
+  };
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, volume.vertex_count()), [&](const tbb::blocked_range<VertexId>& r) {
+    for (VertexId v = r.begin(); v != r.end(); ++v) gather_vertex_rows(volume, v, block, stiffness_);
+  });
+}
+
+void Dynamics::compute_acceleration() {
+  assemble_rotated_stiffness();
+  Vector net = external_forces() - internal_forces();
+  if (settings_.mass_damping_per_s > 0) net -= settings_.mass_damping_per_s * mass_.cwiseProduct(v_);
+  if (settings_.stiffness_damping_s > 0) net -= settings_.stiffness_damping_s * (stiffness_ * v_);
+  a_ = net.cwiseQuotient(mass_);
+  for (std::size_t i = 0; i < fixed_.size(); ++i)
+    if (fixed_[i] != 0) a_[static_cast<Eigen::Index>(i)] = 0.0;
+}
+
+double Dynamics::kinetic_energy_uJ() const { return 0.5 * v_.dot(mass_.cwiseProduct(v_)); }
+
+double Dynamics::elastic_energy_uJ() const {
+  const LinkedVolume& volume = model_.volume;
+  std::vector<Mat3> rotations;
+  cell_rotations(volume, u_, rotations);
+  double energy = 0;
+  for (CellId c = 0; c < volume.cell_count(); ++c) {
+    const auto ci = static_cast<std::size_t>(c);
+    const Vec24 d = corotated_displacement(cell_displacement(volume, c, u_), rotations[ci], table_.cell_size_mm);
+    energy += 0.5 * d.dot(table_.of_label(volume.cell_label(c)).stiffness * d);
+    if (!stress_kPa_.empty()) energy += d.dot(table_.stress_divergence * stress_kPa_[ci]);
+  }
+  return energy;
+}
+
+SolveReport Dynamics::step(double dt) {
+  if (!(dt > 0) || !std::isfinite(dt)) throw InputError(fmt::format("time step is {} s; expected a positive time step in s", dt));
+  constexpr double beta = kNewmarkBeta;
+  constexpr double gamma = kNewmarkGamma;
+  const double alpha_m = settings_.mass_damping_per_s;
+  const double beta_k = settings_.stiffness_damping_s;
+
+  update_rotations();
+  assemble_rotated_stiffness();
+  const double c_mass = 1.0 / (beta * dt * dt) + alpha_m * gamma / (beta * dt);
+  const double c_stiff = 1.0 + beta_k * gamma / (beta * dt);
+
+  // Velocity-like combinations of the old state that enter the increment equation.
+  const Vector inertia_part = v_ / (beta * dt) + (0.5 / beta - 1.0) * a_;
+  const Vector damping_part = (1.0 - gamma / beta) * v_ + dt * (1.0 - 0.5 * gamma / beta) * a_;
+  Vector rhs = external_forces() - internal_forces() + mass_.cwiseProduct(inertia_part);
+  if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damping_part);
+  if (beta_k > 0) rhs -= beta_k * (stiffness_ * damping_part);
+
+  SparseMatrix a = c_stiff * stiffness_;
+  for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += c_mass * mass_[i];
+  FixedDofs held;
+  held.fixed = fixed_;
+  held.value_mm = Vector::Zero(u_.size());
+  eliminate_fixed_dofs(a, rhs, held);
+
+  Vector du = dt * v_ + 0.5 * dt * dt * a_;  // Newmark predictor: warm start
+  for (std::size_t i = 0; i < fixed_.size(); ++i)
+    if (fixed_[i] != 0) du[static_cast<Eigen::Index>(i)] = 0.0;
+  SolveReport report;
+  if (rhs.lpNorm<Eigen::Infinity>() == 0.0) {
+    du.setZero();
+    report.converged = true;
+  } else {
+    solver_->setup(a, model_.volume);
+    report = solver_->solve(rhs, du);
+    require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
+  }
+  if (!du.allFinite()) throw ComputeError(fmt::format("dynamic step with {} produced a non-finite displacement", solver_->name()));
+
+  const Vector a_new = du / (beta * dt * dt) - v_ / (beta * dt) - (0.5 / beta - 1.0) * a_;
+  v_ += dt * ((1.0 - gamma) * a_ + gamma * a_new);
+  a_ = a_new;
+  u_ += du;
+  for (std::size_t i = 0; i < fixed_.size(); ++i)
+    if (fixed_[i] != 0) {
+      v_[static_cast<Eigen::Index>(i)] = 0.0;
+      a_[static_cast<Eigen::Index>(i)] = 0.0;
+    }
+  time_s_ += dt;
+  return report;
+}
+
+}  // namespace cleave

@@ -1,0 +1,99 @@
+#pragma once
+// Corotational linear elasticity with residual stress, integrated by implicit Newmark
+// (beta = 1/4, gamma = 1/2: average acceleration, unconditionally stable, no numerical damping):
+//   M u'' + D u' + f_int(u) = f_ext,   D = alpha M + beta_R K_R,   M lumped.
+// What rotates: each cell c has the rotation R_c of the polar decomposition of its deformation
+// gradient at the cell centre. Its element force is
+//   f_e = R_c [ K^e (R_c^T x_e - X_e) + T^e sigma_c ],
+// i.e. the linear elastic force and the residual stress force are evaluated in the cell's
+// unrotated (reference) frame and rotated into the world: the residual stress tensor is attached
+// to the material and turns with it. The step linearizes f_int at the current state with R fixed
+// (stiffness K_R = sum R K^e R^T) and solves one linear system per step with the chosen solver,
+// warm-started from the Newmark predictor of the previous state.
+//
+//   Dynamics sim(model, stress_kPa, settings);   // model must outlive sim
+//   for (int i = 0; i < n; ++i) sim.step(1e-3);
+//   CutReport r = model.volume.cut_links(links); sim.topology_changed(r);   // then step on
+//
+// Pieces cut free keep their momentum (no gravity unless given; mass damping alpha slows them).
+// Errors: ComputeError (with the residual reached) when a step's solve does not converge.
+#include <memory>
+#include <span>
+#include <string>
+#include <vector>
+
+#include "cleave/fem/element_table.hpp"
+#include "cleave/model/tissue_model.hpp"
+#include "cleave/solve/linear_solver.hpp"
+
+namespace cleave {
+
+inline constexpr double kNewmarkBeta = 0.25;
+inline constexpr double kNewmarkGamma = 0.5;
+
+struct DynamicsSettings {
+  SolverKind solver = SolverKind::multigrid_cg;
+  SolveSettings solve;
+  double mass_damping_per_s = 0;        ///< Rayleigh alpha (1/s)
+  double stiffness_damping_s = 0;       ///< Rayleigh beta (s)
+  std::vector<VertexId> fixed_vertices; ///< held at zero displacement (vertices split off them too)
+  Vec3 gravity_mm_per_s2 = Vec3::Zero();
+  Vector external_force_mN;             ///< constant nodal forces (3 n_v); empty = none
+};
+
+class Dynamics {
+ public:
+  /// Starts at rest (u = 0, u' = 0) on the model's current topology. `residual_stress_kPa` is
+  /// empty (stress free) or one tensor per cell. Throws InputError for mismatched sizes or
+  /// negative damping.
+  Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_kPa, DynamicsSettings settings);
+  ~Dynamics();
+  Dynamics(const Dynamics&) = delete;
+  Dynamics& operator=(const Dynamics&) = delete;
+
+  /// Advances by dt (s > 0). Returns the linear solve's report.
+  SolveReport step(double dt_s);
+
+  /// Call after model.volume.cut_links(...) returned `report`: new vertices take the state of the
+  /// vertex they split off; mass, forces and the stiffness pattern follow the new topology.
+  void topology_changed(const CutReport& report);
+
+  /// Replaces the state (3 n_v each; mm, mm/s) and recomputes the acceleration.
+  void set_state(const Vector& displacement_mm, const Vector& velocity_mm_per_s);
+
+  const Vector& displacement() const { return u_; }  ///< 3 n_v, mm
+  const Vector& velocity() const { return v_; }      ///< 3 n_v, mm/s
+  std::vector<Vec3> displacement_mm() const;
+  double time_s() const { return time_s_; }
+  std::string_view solver_name() const;
+  const std::vector<std::uint8_t>& fixed_dofs() const { return fixed_; }
+
+  /// 1/2 v^T M v (uJ = kg mm^2 / s^2 = mN mm).
+  double kinetic_energy_uJ() const;
+  /// Corotated strain energy plus residual stress work: sum over cells of
+  /// 1/2 d^T K^e d + d^T T^e sigma with d = R^T x_e - X_e (uJ).
+  double elastic_energy_uJ() const;
+
+ private:
+  void rebuild_topology();
+  void update_rotations();
+  Vector internal_forces() const;
+  Vector external_forces() const;
+  void assemble_rotated_stiffness();
+  void compute_acceleration();
+
+  const TissueModel& model_;
+  std::vector<Vec6> stress_kPa_;
+  DynamicsSettings settings_;
+  ElementTable table_;
+  std::unique_ptr<LinearSolver> solver_;
+
+  Vector mass_;    ///< lumped, per dof (kg)
+  std::vector<std::uint8_t> fixed_;
+  SparseMatrix stiffness_;  ///< K_R, pattern of the current topology
+  std::vector<Mat3> rotations_;
+  Vector u_, v_, a_;
+  double time_s_ = 0;
+};
+
+}  // namespace cleave

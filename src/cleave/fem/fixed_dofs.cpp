@@ -1,0 +1,57 @@
+#include "cleave/fem/fixed_dofs.hpp"
+
+#include <algorithm>
+#include <fmt/format.h>
+
+#include "cleave/core/error.hpp"
+
+namespace cleave {
+
+bool FixedDofs::any() const { return std::any_of(fixed.begin(), fixed.end(), [](std::uint8_t f) { return f != 0; }); }
+
+FixedDofs fix_vertices(VertexId vertex_count, std::span<const VertexId> vertices, std::span<const Vec3> displacement_mm) {
+  if (!displacement_mm.empty() && displacement_mm.size() != vertices.size())
+    throw InputError(fmt::format("{} prescribed displacements for {} fixed vertices; expected one per vertex or none",
+                                 displacement_mm.size(), vertices.size()));
+  FixedDofs out;
+  const auto dofs = 3 * static_cast<Eigen::Index>(vertex_count);
+  out.fixed.assign(static_cast<std::size_t>(dofs), 0);
+  out.value_mm = Vector::Zero(dofs);
+  for (std::size_t k = 0; k < vertices.size(); ++k) {
+    const VertexId v = vertices[k];
+    if (v < 0 || v >= vertex_count)
+      throw InputError(fmt::format("fixed vertex {} does not exist; expected an id from 0 to {}", v, vertex_count - 1));
+    for (int i = 0; i < 3; ++i) {
+      out.fixed[static_cast<std::size_t>(3 * v + i)] = 1;
+      out.value_mm[3 * v + i] = displacement_mm.empty() ? 0.0 : displacement_mm[k][i];
+    }
+  }
+  return out;
+}
+
+std::vector<VertexId> vertices_in_box(const LinkedVolume& volume, const Vec3& lo_mm, const Vec3& hi_mm) {
+  std::vector<VertexId> out;
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    const Vec3 p = volume.vertex_position_mm(v);
+    if ((p.array() >= lo_mm.array()).all() && (p.array() <= hi_mm.array()).all()) out.push_back(v);
+  }
+  return out;
+}
+
+void eliminate_fixed_dofs(SparseMatrix& a, Vector& b, const FixedDofs& fixed) {
+  for (Eigen::Index row = 0; row < a.outerSize(); ++row) {
+    const bool row_fixed = fixed.fixed[static_cast<std::size_t>(row)] != 0;
+    for (SparseMatrix::InnerIterator it(a, row); it; ++it) {
+      const Eigen::Index col = it.col();
+      if (row_fixed) {
+        it.valueRef() = col == row ? 1.0 : 0.0;
+      } else if (fixed.fixed[static_cast<std::size_t>(col)] != 0) {
+        b[row] -= it.value() * fixed.value_mm[col];
+        it.valueRef() = 0.0;
+      }
+    }
+    if (row_fixed) b[row] = fixed.value_mm[row];
+  }
+}
+
+}  // namespace cleave

@@ -1,0 +1,95 @@
+#include "cleave/fem/vertex_block_matrix.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace cleave {
+
+void vertex_neighbours(const LinkedVolume& volume, VertexId v, std::vector<VertexId>& out) {
+  out.clear();
+  for (const CellId c : volume.vertex_cells()[static_cast<std::size_t>(v)])
+    for (const VertexId w : volume.cell_vertices(c)) out.push_back(w);
+  std::sort(out.begin(), out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
+}
+
+namespace {
+
+/// Shared by the fresh and the incremental pattern: `previous` is null for a fresh one.
+SparseMatrix build_pattern(const LinkedVolume& volume, const SparseMatrix* previous,
+                           const std::vector<std::uint8_t>* affected) {
+  const VertexId n = volume.vertex_count();
+  volume.vertex_cells();  // build the lazy cache before the parallel loops
+  const auto copied = [&](VertexId v) {
+    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && 3 * v < previous->rows();
+  };
+  std::vector<std::int64_t> row_width(static_cast<std::size_t>(n));
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
+    std::vector<VertexId> neighbours;
+    for (VertexId v = range.begin(); v != range.end(); ++v) {
+      if (copied(v)) {
+        row_width[static_cast<std::size_t>(v)] = previous->outerIndexPtr()[3 * v + 1] - previous->outerIndexPtr()[3 * v];
+      } else {
+        vertex_neighbours(volume, v, neighbours);
+        row_width[static_cast<std::size_t>(v)] = 3 * static_cast<std::int64_t>(neighbours.size());
+      }
+    }
+  });
+  SparseMatrix m(3 * static_cast<Eigen::Index>(n), 3 * static_cast<Eigen::Index>(n));
+  std::int64_t nnz = 0;
+  for (VertexId v = 0; v < n; ++v) nnz += 3 * row_width[static_cast<std::size_t>(v)];
+  m.resizeNonZeros(static_cast<Eigen::Index>(nnz));
+  auto* outer = m.outerIndexPtr();
+  std::int64_t at = 0;
+  for (VertexId v = 0; v < n; ++v)
+    for (int i = 0; i < 3; ++i) {
+      outer[3 * v + i] = static_cast<SparseMatrix::StorageIndex>(at);
+      at += row_width[static_cast<std::size_t>(v)];
+    }
+  outer[3 * n] = static_cast<SparseMatrix::StorageIndex>(at);
+
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
+    std::vector<VertexId> neighbours;
+    for (VertexId v = range.begin(); v != range.end(); ++v) {
+      const auto width = row_width[static_cast<std::size_t>(v)];
+      if (copied(v)) {
+        for (int i = 0; i < 3; ++i) {
+          const auto from = previous->outerIndexPtr()[3 * v + i];
+          std::copy_n(previous->innerIndexPtr() + from, width, m.innerIndexPtr() + outer[3 * v + i]);
+          std::copy_n(previous->valuePtr() + from, width, m.valuePtr() + outer[3 * v + i]);
+        }
+        continue;
+      }
+      vertex_neighbours(volume, v, neighbours);
+      for (int i = 0; i < 3; ++i) {
+        auto* columns = m.innerIndexPtr() + outer[3 * v + i];
+        for (std::size_t k = 0; k < neighbours.size(); ++k)
+          for (int j = 0; j < 3; ++j) columns[3 * k + static_cast<std::size_t>(j)] = 3 * neighbours[k] + j;
+        std::fill_n(m.valuePtr() + outer[3 * v + i], width, 0.0);
+      }
+    }
+  });
+  return m;
+}
+
+}  // namespace
+
+SparseMatrix make_vertex_block_pattern(const LinkedVolume& volume) { return build_pattern(volume, nullptr, nullptr); }
+
+SparseMatrix rebuild_vertex_block_pattern(const LinkedVolume& volume, const SparseMatrix& previous,
+                                          const std::vector<std::uint8_t>& affected) {
+  return build_pattern(volume, &previous, &affected);
+}
+
+std::vector<std::uint8_t> vertices_affected_by_cut(const LinkedVolume& volume, const CutReport& report) {
+  std::vector<std::uint8_t> affected(static_cast<std::size_t>(volume.vertex_count()), 0);
+  for (const CellId c : report.touched_cells)
+    for (const VertexId v : volume.cell_vertices(c)) affected[static_cast<std::size_t>(v)] = 1;
+  for (const VertexSplit& split : report.splits) {
+    affected[static_cast<std::size_t>(split.original)] = 1;
+    for (const VertexId v : split.created) affected[static_cast<std::size_t>(v)] = 1;
+  }
+  return affected;
+}
+
+}  // namespace cleave
