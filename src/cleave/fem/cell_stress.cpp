@@ -1,5 +1,6 @@
 #include "cleave/fem/cell_stress.hpp"
 
+#include <Eigen/LU>
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"

@@ -1,5 +1,6 @@
 #include "cleave/fem/corotation.hpp"
 
+#include <Eigen/LU>
 #include <Eigen/SVD>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
