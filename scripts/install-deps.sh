@@ -10,7 +10,7 @@ packages=(
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libsuitesparse-dev
   # tests and benchmarks
-  libgtest-dev libgmock-dev libbenchmark-dev
+  libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
   # model formats: volumes (NRRD, NIfTI), meshes, voxelization
   zlib1g-dev libteem-dev libnifti2-dev libassimp-dev libopenvdb-dev
   # studio server (Boost.Beast is header-only in libboost-dev)

@@ -1,0 +1,69 @@
+#pragma once
+// What `cleave bench` measures for one model: per implementation (cleave itself and each peer)
+// the time of every stage, its solver iterations, its agreement with cleave's result, and the
+// peak memory. Plain data; bench_report.hpp turns it into JSON and tables.
+//
+// Stages (keys as in the JSON output):
+//   vector       eigenvector interpolation: Langer and normal line fields, orthonormalization
+//   value        eigenvalue interpolation: Laplacian + control points + equilibrium (least squares)
+//   equilibrate  making the designed stress exactly self-balanced
+//   preview      one incision-preview solve: statics of the body with round incisions cut
+//   step         one implicit corotational Newmark step during an ongoing cut
+//   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface
+#include <optional>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "bench_models.hpp"
+#include "timing_statistics.hpp"
+
+namespace cleave::bench {
+
+/// Who computes: cleave's own fast path or one of the peers re-run on the same systems.
+enum class Implementation {
+  cleave,    ///< cleave's defaults: multigrid CG, multi-threaded, warm-started
+  paper,     ///< the paper's algorithms on one thread (plain CG, CG on the normal equations)
+  eigen_cg,  ///< Eigen's ConjugateGradient with incomplete Cholesky
+  cholmod,   ///< SuiteSparse CHOLMOD sparse Cholesky
+};
+
+/// "cleave", "paper", "eigen_cg", "cholmod" (the JSON keys).
+std::string_view implementation_key(Implementation implementation);
+/// Inverse of implementation_key; throws InputError naming `option` and listing the keys.
+Implementation implementation_from_key(std::string_view key, std::string_view option);
+
+enum class Stage { vector, value, equilibrate, preview, step, update };
+inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value, Stage::equilibrate,
+                                       Stage::preview, Stage::step, Stage::update};
+/// "vector", "value", "equilibrate", "preview", "step", "update".
+std::string_view stage_key(Stage stage);
+
+struct StageFigures {
+  TimingStatistics time;  ///< count 0 = not run (see `skipped`)
+  int iterations = 0;     ///< solver iterations of one run of the stage (sum over its solves)
+  /// ||x - x_cleave|| / ||x_cleave|| of the stage's result against cleave's (peers only).
+  std::optional<double> relative_difference;
+  std::string skipped;    ///< why the stage was not run for this implementation; empty when run
+};
+
+struct ImplementationFigures {
+  Implementation implementation = Implementation::cleave;
+  std::string solver;  ///< the solver's own name as it reports it
+  StageFigures vector, value, equilibrate, preview, step, update;
+  double peak_mb = 0;  ///< peak resident memory while this implementation ran (MB = 1e6 bytes)
+
+  StageFigures& stage(Stage s);
+  const StageFigures& stage(Stage s) const;
+};
+
+struct ModelFigures {
+  BenchModel model;
+  int cells = 0;
+  int vertices = 0;
+  int incisions = 0;  ///< round incisions in the preview
+  ImplementationFigures cleave;
+  std::vector<ImplementationFigures> peers;
+};
+
+}  // namespace cleave::bench

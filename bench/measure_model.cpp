@@ -1,0 +1,86 @@
+#include "measure_model.hpp"
+
+#include <fmt/format.h>
+
+#include "cleave/shapes/builtin_shapes.hpp"
+#include "implementation_setup.hpp"
+#include "measure_mechanics.hpp"
+#include "peak_memory.hpp"
+
+namespace cleave::bench {
+namespace {
+
+/// What one implementation produced on one model, kept to compare the peers with cleave.
+struct ImplementationResults {
+  ImplementationFigures figures;
+  Eigen::VectorXd preview_mm;
+  Eigen::VectorXd step_mm;
+};
+
+ImplementationResults run_implementation(const TissueModel& model, const BenchScenario& scenario,
+                                         Implementation implementation, const BenchOptions& options,
+                                         const ProgressFn& progress, double done, double share) {
+  ImplementationResults r;
+  r.figures.implementation = implementation;
+  reset_peak_resident_memory();
+  const std::string who(implementation_key(implementation));
+  report(progress, who + ": incision preview", done);
+  MechanicsOutcome preview = measure_incision_preview(model, scenario, implementation, options.repeat);
+  report(progress, who + ": dynamic step", done + 0.5 * share);
+  MechanicsOutcome step = measure_dynamic_step(model, scenario, implementation, options.repeat);
+  r.figures.preview = preview.figures;
+  r.figures.step = step.figures;
+  r.figures.solver = preview.solver;
+  r.preview_mm = std::move(preview.displacement_mm);
+  r.step_mm = std::move(step.displacement_mm);
+  r.figures.peak_mb = peak_resident_memory_mb();
+  return r;
+}
+
+void compare_with_cleave(const ImplementationResults& cleave, ImplementationResults& peer) {
+  peer.figures.preview.relative_difference = relative_difference(peer.preview_mm, cleave.preview_mm);
+  peer.figures.step.relative_difference = relative_difference(peer.step_mm, cleave.step_mm);
+}
+
+ImplementationFigures skipped(Implementation implementation, const std::string& why) {
+  ImplementationFigures f;
+  f.implementation = implementation;
+  for (Stage s : kAllStages) f.stage(s).skipped = why;
+  return f;
+}
+
+}  // namespace
+
+ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& options, const ProgressFn& progress) {
+  report(progress, fmt::format("{}: building", bench_model.key), 0.0);
+  const TissueModel model =
+      make_tissue_model(bench_model.shape, make_builtin_shape(bench_model.shape, {bench_model.cells, std::nullopt}));
+  ScenarioOptions scenario_options;
+  scenario_options.cut_segments = kWarmUpSteps + std::max(options.repeat, 1);
+  const BenchScenario scenario = make_bench_scenario(model, scenario_options);
+
+  ModelFigures figures;
+  figures.model = bench_model;
+  figures.cells = model.volume.cell_count();
+  figures.vertices = model.volume.vertex_count();
+  figures.incisions = static_cast<int>(scenario.incisions.incisions.size());
+
+  const double share = 1.0 / static_cast<double>(1 + options.peers.size());
+  const ImplementationResults cleave =
+      run_implementation(model, scenario, Implementation::cleave, options, progress, 0.0, share);
+  figures.cleave = cleave.figures;
+  for (std::size_t i = 0; i < options.peers.size(); ++i) {
+    const Implementation peer = options.peers[i];
+    if (figures.cells > options.peer_max_cells) {
+      figures.peers.push_back(skipped(peer, fmt::format("{} cells is above --peer-max-cells {}", figures.cells, options.peer_max_cells)));
+      continue;
+    }
+    ImplementationResults r = run_implementation(model, scenario, peer, options, progress, share * static_cast<double>(i + 1), share);
+    compare_with_cleave(cleave, r);
+    figures.peers.push_back(std::move(r.figures));
+  }
+  report(progress, fmt::format("{}: done", bench_model.key), 1.0);
+  return figures;
+}
+
+}  // namespace cleave::bench

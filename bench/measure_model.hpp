@@ -1,0 +1,28 @@
+#pragma once
+// One model of `cleave bench`, end to end: build it at its resolution, fix the scenario, run
+// every stage for cleave and then for each peer on the same systems, compare each peer's results
+// with cleave's, and record the peak memory of each implementation.
+//
+//   BenchOptions options;                       // repeat 5, peers paper + eigen_cg + cholmod
+//   ModelFigures f = measure_model(table1_models()[1], options, progress);
+//
+// Peers are skipped (with the reason recorded) on models above `peer_max_cells`, where a
+// single-threaded or direct solver would take minutes and tens of GB. Progress goes to
+// `progress` (stage name, fraction of this model done). Errors: InputError for a bad scenario,
+// ComputeError when a solver fails.
+#include <vector>
+
+#include "bench_figures.hpp"
+#include "cleave/core/progress.hpp"
+
+namespace cleave::bench {
+
+struct BenchOptions {
+  int repeat = 5;  ///< timed runs per stage (medians over these)
+  std::vector<Implementation> peers = {Implementation::paper, Implementation::eigen_cg, Implementation::cholmod};
+  int peer_max_cells = 400'000;  ///< peers are skipped on larger models
+};
+
+ModelFigures measure_model(const BenchModel& model, const BenchOptions& options, const ProgressFn& progress);
+
+}  // namespace cleave::bench
