@@ -1,5 +1,6 @@
 #include "cleave/fem/dynamics.hpp"
 
+#include <algorithm>
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -43,6 +44,14 @@ std::string_view Dynamics::solver_name() const { return solver_->name(); }
 void Dynamics::rebuild_topology() {
   mass_ = lumped_mass(model_, table_);
   stiffness_ = make_vertex_block_pattern(model_.volume);
+  system_ = stiffness_;
+  diagonal_.assign(static_cast<std::size_t>(stiffness_.rows()), 0);
+  for (Eigen::Index row = 0; row < stiffness_.rows(); ++row) {
+    const auto* begin = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[row];
+    const auto* end = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[row + 1];
+    diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - stiffness_.innerIndexPtr();
+  }
+  any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
   update_rotations();
 }
 
@@ -174,12 +183,20 @@ SolveReport Dynamics::step(double dt) {
   if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damping_part);
   if (beta_k > 0) rhs -= beta_k * (stiffness_ * damping_part);
 
-  SparseMatrix a = c_stiff * stiffness_;
-  for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += c_mass * mass_[i];
-  FixedDofs held;
-  held.fixed = fixed_;
-  held.value_mm = Vector::Zero(u_.size());
-  eliminate_fixed_dofs(a, rhs, held);
+  {
+    const double* k = stiffness_.valuePtr();
+    double* a = system_.valuePtr();
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, stiffness_.nonZeros()), [&](const tbb::blocked_range<Eigen::Index>& r) {
+      for (Eigen::Index i = r.begin(); i != r.end(); ++i) a[i] = c_stiff * k[i];
+    });
+    for (Eigen::Index i = 0; i < system_.rows(); ++i) a[diagonal_[static_cast<std::size_t>(i)]] += c_mass * mass_[i];
+  }
+  if (any_fixed_) {
+    FixedDofs held;
+    held.fixed = fixed_;
+    held.value_mm = Vector::Zero(u_.size());
+    eliminate_fixed_dofs(system_, rhs, held);
+  }
 
   Vector du = dt * v_ + 0.5 * dt * dt * a_;  // Newmark predictor: warm start
   for (std::size_t i = 0; i < fixed_.size(); ++i)
@@ -189,7 +206,7 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    solver_->setup(a, model_.volume);
+    solver_->setup(system_, model_.volume);
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

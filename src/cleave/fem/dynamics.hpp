@@ -91,6 +91,9 @@ class Dynamics {
   Vector mass_;    ///< lumped, per dof (kg)
   std::vector<std::uint8_t> fixed_;
   SparseMatrix stiffness_;  ///< K_R, pattern of the current topology
+  SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; same pattern as stiffness_
+  std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
+  bool any_fixed_ = false;
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;
   double time_s_ = 0;

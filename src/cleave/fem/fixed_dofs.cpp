@@ -39,18 +39,28 @@ std::vector<VertexId> vertices_in_box(const LinkedVolume& volume, const Vec3& lo
 }
 
 void eliminate_fixed_dofs(SparseMatrix& a, Vector& b, const FixedDofs& fixed) {
-  for (Eigen::Index row = 0; row < a.outerSize(); ++row) {
-    const bool row_fixed = fixed.fixed[static_cast<std::size_t>(row)] != 0;
-    for (SparseMatrix::InnerIterator it(a, row); it; ++it) {
-      const Eigen::Index col = it.col();
-      if (row_fixed) {
-        it.valueRef() = col == row ? 1.0 : 0.0;
-      } else if (fixed.fixed[static_cast<std::size_t>(col)] != 0) {
-        b[row] -= it.value() * fixed.value_mm[col];
-        it.valueRef() = 0.0;
-      }
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  double* values = a.valuePtr();
+  const auto is_fixed = [&](Eigen::Index dof) { return fixed.fixed[static_cast<std::size_t>(dof)] != 0; };
+  // Work only around the fixed dofs: entry (i, j) with j fixed is found from row j through the
+  // symmetric pattern, so the cost is proportional to the fixed rows, not to the matrix.
+  for (Eigen::Index j = 0; j < a.rows(); ++j) {
+    if (!is_fixed(j)) continue;
+    const double prescribed = fixed.value_mm[j];
+    for (auto k = outer[j]; k < outer[j + 1]; ++k) {
+      const Eigen::Index i = inner[k];
+      if (i == j || is_fixed(i)) continue;
+      const auto* row_begin = inner + outer[i];
+      const auto* row_end = inner + outer[i + 1];
+      const auto* found = std::lower_bound(row_begin, row_end, static_cast<SparseMatrix::StorageIndex>(j));
+      if (found == row_end || *found != j) continue;  // structurally zero
+      double& entry = values[found - inner];
+      b[i] -= entry * prescribed;
+      entry = 0.0;
     }
-    if (row_fixed) b[row] = fixed.value_mm[row];
+    for (auto k = outer[j]; k < outer[j + 1]; ++k) values[k] = inner[k] == j ? 1.0 : 0.0;
+    b[j] = prescribed;
   }
 }
 

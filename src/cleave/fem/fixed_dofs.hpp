@@ -29,6 +29,8 @@ FixedDofs fix_vertices(VertexId vertex_count, std::span<const VertexId> vertices
 std::vector<VertexId> vertices_in_box(const LinkedVolume& volume, const Vec3& lo_mm, const Vec3& hi_mm);
 
 /// Eliminates the fixed dofs from A x = b in place (A keeps its pattern; entries become 0).
+/// A must be compressed with a structurally symmetric pattern (as every vertex-block matrix is);
+/// the work is proportional to the entries of the fixed rows.
 void eliminate_fixed_dofs(SparseMatrix& a, Vector& b, const FixedDofs& fixed);
 
 }  // namespace cleave
