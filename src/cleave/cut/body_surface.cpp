@@ -11,6 +11,7 @@ constexpr int kNewtonSteps = 12;
 constexpr double kNewtonStopCells = 1e-6;      ///< stop when |phi| < this many cells
 constexpr double kNormalRadiusCells = 2.0;     ///< face normals averaged within this radius (no field)
 constexpr double kThicknessStepCells = 0.25;   ///< marching step of thickness_mm
+constexpr int kBisectionSteps = 30;
 
 Vec3 face_normal(Face f) { return face_step(f).cast<double>(); }
 
@@ -75,18 +76,30 @@ Vec3 BodySurface::normal_at(const Vec3& p_mm) const {
     const Vec3 g = field_gradient(p_mm);
     if (g.norm() > 0) return g.normalized();
   }
+  if (face_normal_.empty()) return Vec3::UnitZ();
+  const Vec3 nearest = face_normal_[closest_face(p_mm)];
   const double radius = kNormalRadiusCells * cell_size_mm();
   Vec3 sum = Vec3::Zero();
   for (std::size_t i = 0; i < face_centre_mm_.size(); ++i)
-    if ((face_centre_mm_[i] - p_mm).norm() <= radius) sum += face_normal_[i];
-  if (sum.norm() > 0) return sum.normalized();
-  return face_normal_.empty() ? Vec3::UnitZ() : face_normal_[closest_face(p_mm)];
+    if ((face_centre_mm_[i] - p_mm).norm() <= radius && face_normal_[i].dot(nearest) > 0) sum += face_normal_[i];
+  return sum.norm() > 0 ? Vec3(sum.normalized()) : nearest;
+}
+
+Vec3 BodySurface::onto_closest_face(const Vec3& p_mm) const {
+  const std::size_t i = closest_face(p_mm);
+  const Vec3& c = face_centre_mm_[i];
+  const Vec3& n = face_normal_[i];
+  const double half = 0.5 * cell_size_mm();
+  Vec3 q = p_mm - (p_mm - c).dot(n) * n;  // onto the face's plane, then clamped to the face
+  for (int a = 0; a < 3; ++a)
+    if (n[a] == 0) q[a] = std::clamp(q[a], c[a] - half, c[a] + half);
+  return q;
 }
 
 double BodySurface::distance_mm(const Vec3& p_mm) const {
   if (has_field_) return std::abs(field_mm(p_mm));
   if (face_centre_mm_.empty()) return std::numeric_limits<double>::infinity();
-  return (face_centre_mm_[closest_face(p_mm)] - p_mm).norm();
+  return (onto_closest_face(p_mm) - p_mm).norm();
 }
 
 std::optional<SurfacePoint> BodySurface::project(const Vec3& p_mm, double tolerance_mm) const {
@@ -100,9 +113,9 @@ std::optional<SurfacePoint> BodySurface::project(const Vec3& p_mm, double tolera
       if (!(g.squaredNorm() > 0)) break;
       q -= phi * g / g.squaredNorm();
     }
-    if (std::abs(field_mm(q)) > 0.1 * cell_size_mm()) q = face_centre_mm_[closest_face(p_mm)];
+    if (std::abs(field_mm(q)) > 0.1 * cell_size_mm()) q = onto_closest_face(p_mm);
   } else {
-    q = face_centre_mm_[closest_face(p_mm)];
+    q = onto_closest_face(p_mm);
   }
   if ((q - p_mm).norm() > tolerance_mm || !std::isfinite(q.squaredNorm())) return std::nullopt;
   return SurfacePoint{q, normal_at(q)};
@@ -127,7 +140,12 @@ double BodySurface::thickness_mm(const Vec3& p_mm, const Vec3& inward) const {
   while (s <= reach && !inside(p_mm + s * inward)) s += step;
   if (s > reach) return 0;
   while (s <= reach && inside(p_mm + s * inward)) s += step;
-  return s - 0.5 * step;
+  double in = s - step, out = s;  // the exit lies between; bisect to a tiny fraction of a cell
+  for (int i = 0; i < kBisectionSteps; ++i) {
+    const double mid = 0.5 * (in + out);
+    (inside(p_mm + mid * inward) ? in : out) = mid;
+  }
+  return 0.5 * (in + out);
 }
 
 }  // namespace cleave

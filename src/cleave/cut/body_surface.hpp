@@ -6,8 +6,9 @@
 //     corner distances); normals are its normalized gradient and projection is Newton's method
 //     along the gradient;
 //   - without one, the surface is the set of boundary voxel faces (faces with no neighbouring
-//     cell); normals are the area-weighted mean of the boundary face normals within two cells,
-//     and projection goes to the closest boundary face centre.
+//     cell); normals are those of the closest boundary face (the mean over faces within two cells
+//     that face the same way, so a corner or an edge of the body does not tilt them),
+//     and projection goes to the closest point of the boundary face with the closest centre.
 //
 //   BodySurface surface(model);
 //   std::optional<SurfacePoint> s = surface.project(p_mm);   // nullopt: farther than the tolerance
@@ -16,6 +17,7 @@
 // "Outer" side: a surface point whose outward normal points away from the centre of the body's
 // bounding box. For the shells cleave models (tube, abdomen) this is the skin and excludes the
 // inner surface; for a plate it is both faces.
+#include <Eigen/Geometry>
 #include <optional>
 #include <vector>
 
@@ -62,6 +64,8 @@ class BodySurface {
   double field_mm(const Vec3& p_mm) const;
   Vec3 field_gradient(const Vec3& p_mm) const;
   std::size_t closest_face(const Vec3& p_mm) const;
+  /// Closest point on the closest boundary face (by centre distance).
+  Vec3 onto_closest_face(const Vec3& p_mm) const;
 
   const TissueModel& model_;
   bool has_field_ = false;

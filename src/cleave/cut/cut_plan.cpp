@@ -11,6 +11,7 @@ namespace cleave {
 namespace {
 
 constexpr int kRimChecks = 16;                  ///< rim points checked to lie on the surface
+constexpr double kRimNormalAgreement = 0.5;     ///< least cosine between rim and centre normals
 constexpr double kDepthSlackCells = 0.5;        ///< depth may exceed the measured thickness by this
 constexpr double kMinPathLengthCells = 0.5;
 constexpr double kMaxBladeAngleDeg = 90.0;
@@ -45,7 +46,8 @@ IncisionFrame checked_incision(const BodySurface& surface, const RoundIncision& 
   }
   for (int k = 0; k < kRimChecks; ++k) {
     const Vec3 p = frame.rim_point(2 * std::numbers::pi * k / kRimChecks, 0.0);
-    if (!surface.project(p, tol + in.radius_mm * (1 - std::cos(std::numbers::pi / 4))))
+    const auto q = surface.project(p, h + in.radius_mm * (1 - std::cos(std::numbers::pi / 4)));
+    if (!q || q->normal.dot(frame.normal) < kRimNormalAgreement)
       throw InputError(fmt::format("{}: radius {:.3g} mm at ({:.3g}, {:.3g}, {:.3g}) mm reaches off the body's "
                                    "surface; expected an incision that fits on the body",
                                    who, in.radius_mm, frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()));

@@ -94,10 +94,6 @@ FlapRegion flap_region(const BodySurface& surface, const Flap& flap, double tole
   r.normal = normal_sum.normalized();
   std::tie(r.tangent_u, r.tangent_v) = tangent_frame(r.normal);
   for (const SurfacePoint& s : snapped) r.polygon.push_back(r.to_plane(s.position_mm));
-  const double area = polygon_area(r.polygon);
-  if (area < h * h)
-    throw InputError(fmt::format("flap path encloses {:.3g} mm^2; expected at least one cell face ({:.3g} mm^2)",
-                                 area, h * h));
   const auto crossings = polygon_self_intersections(r.polygon);
   if (!crossings.empty())
     throw InputError(fmt::format("flap path intersects itself (segment {} crosses segment {}{}); expected a simple "
@@ -106,6 +102,10 @@ FlapRegion flap_region(const BodySurface& surface, const Flap& flap, double tole
                                  flap.shape == FlapShape::u_shaped && crossings.front().second == r.polygon.size() - 1
                                      ? ", the hinge between its ends"
                                      : ""));
+  const double area = polygon_area(r.polygon);
+  if (area < h * h)
+    throw InputError(fmt::format("flap path encloses {:.3g} mm^2; expected at least one cell face ({:.3g} mm^2)",
+                                 area, h * h));
   // Cells belong to the flap only within a slab under the path (not the far side of a shell).
   double sag_mm = 0;
   for (const SurfacePoint& s : snapped) sag_mm = std::max(sag_mm, std::abs((s.position_mm - r.origin_mm).dot(r.normal)));

@@ -9,6 +9,7 @@
 // Each link appears once, as (cell, positive face 1/3/5), in ascending cell order. Links that are
 // already cut are left out. Touching counts as crossing (a segment through a triangle's edge or
 // an end point on its plane), so two triangles sharing an edge leave no gap.
+#include <Eigen/Geometry>
 #include <array>
 #include <span>
 #include <vector>

@@ -44,14 +44,15 @@ SweptPath sweep_path(const BodySurface& surface, const std::vector<Vec3>& path_m
   const std::size_t n = out.skin_mm.size();
   for (std::size_t i = 0; i < n; ++i) {
     const Vec3 ahead = out.skin_mm[std::min(i + 1, n - 1)] - out.skin_mm[i > 0 ? i - 1 : 0];
-    const Vec3 inward = -out.normal[i];
-    Vec3 tangent = ahead - ahead.dot(out.normal[i]) * out.normal[i];
-    if (!(tangent.norm() > 0)) {
-      out.blade.push_back(inward);
+    if (!(ahead.norm() > 0)) {
+      out.blade.push_back(-out.normal[i]);
       continue;
     }
-    tangent.normalize();
-    const Vec3 side = tangent.cross(inward);  // in the tangent plane, perpendicular to the path
+    // The blade stands in the plane normal to the path: inward normal without its along-path part.
+    const Vec3 tangent = ahead.normalized();
+    Vec3 inward = -(out.normal[i] - out.normal[i].dot(tangent) * tangent);
+    inward = inward.norm() > 0 ? inward.normalized() : Vec3(-out.normal[i]);
+    const Vec3 side = tangent.cross(inward);
     out.blade.push_back((std::cos(angle) * inward + std::sin(angle) * side).normalized());
   }
   return out;
