@@ -1,0 +1,145 @@
+#include "cleave/io/nifti_volume.hpp"
+
+#include <cmath>
+#include <cstdlib>
+#include <fmt/format.h>
+#include <memory>
+#include <nifti2_io.h>
+
+#include "cleave/core/error.hpp"
+#include "cleave/core/memory_budget.hpp"
+
+namespace cleave {
+namespace {
+
+struct NiftiDeleter {
+  void operator()(nifti_image* n) const { nifti_image_free(n); }
+};
+using NiftiPtr = std::unique_ptr<nifti_image, NiftiDeleter>;
+
+constexpr double kMetresToMm = 1000.0;
+constexpr double kMicronsToMm = 0.001;
+
+double unit_to_mm(int xyz_units) {
+  switch (xyz_units) {
+    case NIFTI_UNITS_METER: return kMetresToMm;
+    case NIFTI_UNITS_MICRON: return kMicronsToMm;
+    default: return 1.0;  // mm, or unknown (taken as mm, as most tools do)
+  }
+}
+
+/// Raw pixdim[1..3] of the header on disk (nifticlib replaces a zero pixdim by 1 when it builds
+/// the image, which would hide a broken file).
+Vec3 raw_pixdims(const std::string& f) {
+  int version = 0;
+  void* header = nifti_read_header(f.c_str(), &version, /*check=*/1);
+  if (header == nullptr)
+    throw InputError(fmt::format("{}: not a readable NIfTI-1/NIfTI-2 file (missing, truncated or malformed header)", f));
+  Vec3 pixdim;
+  if (version == 2) {
+    const auto* h = static_cast<const nifti_2_header*>(header);
+    pixdim = {h->pixdim[1], h->pixdim[2], h->pixdim[3]};
+  } else {
+    const auto* h = static_cast<const nifti_1_header*>(header);
+    pixdim = {static_cast<double>(h->pixdim[1]), static_cast<double>(h->pixdim[2]), static_cast<double>(h->pixdim[3])};
+  }
+  std::free(header);
+  return pixdim;
+}
+
+/// Reads sample n of `nim` as a double (integer and real scalar types).
+double sample(const nifti_image& nim, size_t n) {
+  const void* d = nim.data;
+  switch (nim.datatype) {
+    case DT_UINT8: return static_cast<const std::uint8_t*>(d)[n];
+    case DT_INT8: return static_cast<const std::int8_t*>(d)[n];
+    case DT_UINT16: return static_cast<const std::uint16_t*>(d)[n];
+    case DT_INT16: return static_cast<const std::int16_t*>(d)[n];
+    case DT_UINT32: return static_cast<const std::uint32_t*>(d)[n];
+    case DT_INT32: return static_cast<const std::int32_t*>(d)[n];
+    case DT_UINT64: return static_cast<double>(static_cast<const std::uint64_t*>(d)[n]);
+    case DT_INT64: return static_cast<double>(static_cast<const std::int64_t*>(d)[n]);
+    case DT_FLOAT32: return static_cast<double>(static_cast<const float*>(d)[n]);
+    case DT_FLOAT64: return static_cast<const double*>(d)[n];
+    default: return 0.0;  // rejected before reading
+  }
+}
+
+bool is_scalar_type(int datatype) {
+  switch (datatype) {
+    case DT_UINT8: case DT_INT8: case DT_UINT16: case DT_INT16: case DT_UINT32: case DT_INT32:
+    case DT_UINT64: case DT_INT64: case DT_FLOAT32: case DT_FLOAT64:
+      return true;
+    default:
+      return false;
+  }
+}
+
+}  // namespace
+
+ImageVolume read_nifti_volume(const std::filesystem::path& file) {
+  std::error_code ec;
+  if (!std::filesystem::is_regular_file(file, ec)) throw InputError(fmt::format("{}: no such file", file.string()));
+  const std::string f = file.string();
+  nifti_set_debug_level(0);  // nifticlib prints to stderr otherwise; errors are reported here
+
+  const Vec3 pixdim = raw_pixdims(f);
+  NiftiPtr nim(nifti_image_read(f.c_str(), /*read_data=*/0));
+  if (!nim) throw InputError(fmt::format("{}: not a readable NIfTI-1/NIfTI-2 file (malformed header)", f));
+  if (!is_scalar_type(nim->datatype))
+    throw InputError(fmt::format("{}: sample type {} is not a scalar number; expected integer or real samples", f,
+                                 nifti_datatype_string(nim->datatype)));
+  if (nim->nt * nim->nu * nim->nv * nim->nw > 1)
+    throw InputError(fmt::format("{}: holds {} volumes; expected a single 3-D volume", f,
+                                 nim->nt * nim->nu * nim->nv * nim->nw));
+  if (nim->nx <= 0 || nim->ny <= 0 || nim->nz <= 0 || nim->nx > std::numeric_limits<int>::max() ||
+      nim->ny > std::numeric_limits<int>::max() || nim->nz > std::numeric_limits<int>::max())
+    throw InputError(fmt::format("{}: image size {}x{}x{}; expected 1 to 2^31 samples along each axis", f, nim->nx,
+                                 nim->ny, nim->nz));
+  const auto samples = static_cast<std::uint64_t>(nim->nx) * static_cast<std::uint64_t>(nim->ny) *
+                       static_cast<std::uint64_t>(nim->nz);
+  require_memory(samples * (static_cast<std::uint64_t>(nim->nbyper) + sizeof(double)),
+                 fmt::format("{} ({}x{}x{} samples)", f, nim->nx, nim->ny, nim->nz));
+
+  ImageVolume image;
+  image.source = f;
+  image.dims = {static_cast<int>(nim->nx), static_cast<int>(nim->ny), static_cast<int>(nim->nz)};
+  const double to_mm = unit_to_mm(nim->xyz_units);
+  if (nim->sform_code > 0) {
+    for (int r = 0; r < 3; ++r) {
+      for (int c = 0; c < 3; ++c) image.index_to_world(r, c) = to_mm * nim->sto_xyz.m[r][c];
+      image.origin_mm[r] = to_mm * nim->sto_xyz.m[r][3];
+    }
+  } else {
+    for (int a = 0; a < 3; ++a)
+      if (!(pixdim[a] > 0) || !std::isfinite(pixdim[a]))
+        throw InputError(fmt::format("{}: spacing of axis {} (pixdim[{}]) is {} mm; expected a positive spacing", f, a,
+                                     a + 1, pixdim[a]));
+    if (nim->qform_code > 0) {
+      for (int r = 0; r < 3; ++r) {
+        for (int c = 0; c < 3; ++c) image.index_to_world(r, c) = to_mm * nim->qto_xyz.m[r][c];
+        image.origin_mm[r] = to_mm * nim->qto_xyz.m[r][3];
+      }
+    } else {
+      image.index_to_world = (to_mm * pixdim).asDiagonal();
+    }
+  }
+  image.integer_samples = nim->datatype != DT_FLOAT32 && nim->datatype != DT_FLOAT64;
+
+  if (nifti_image_load(nim.get()) != 0 || nim->data == nullptr)
+    throw InputError(fmt::format("{}: the image data is truncated or unreadable (expected {} bytes of samples)", f,
+                                 samples * static_cast<std::uint64_t>(nim->nbyper)));
+  const bool scaled = nim->scl_slope != 0.0 && std::isfinite(nim->scl_slope) && std::isfinite(nim->scl_inter) &&
+                      !(nim->scl_slope == 1.0 && nim->scl_inter == 0.0);
+  if (scaled && (nim->scl_slope != std::round(nim->scl_slope) || nim->scl_inter != std::round(nim->scl_inter)))
+    image.integer_samples = false;
+  image.values.resize(static_cast<size_t>(samples));
+  for (size_t n = 0; n < image.values.size(); ++n) {
+    const double raw = sample(*nim, n);
+    image.values[n] = scaled ? nim->scl_slope * raw + nim->scl_inter : raw;
+  }
+  check_image_volume(image);
+  return image;
+}
+
+}  // namespace cleave
