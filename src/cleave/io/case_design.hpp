@@ -1,0 +1,31 @@
+#pragma once
+// The case section "design" (issue 4, item 6): the residual stress designed from strokes and
+// control points (paper section 4) instead of given directly ("residual_stress").
+//
+//   "design": {
+//     "strokes": [ {"points": [[x, y, z], ...], "interior": false}, ... ],   mm; >= 2 points each
+//     "control_points": [ {"position": [x, y, z], "langer_kPa": 20, "cross_kPa": 10}, ... ],  >= 1
+//     "weights": {"laplacian": 1, "constraint": 1000, "equilibrium": 1},       optional, defaults shown
+//     "equilibrate": true,                                                     optional, default true
+//     "solver": "default" | "paper-cg",                                        optional, default "default"
+//     "snap_tolerance_cells": 2                                                optional, > 0
+//   }
+//
+// "interior": true marks a stroke inside the body (not snapped). Errors are InputErrors naming the
+// file, JSON path, value and expectation, e.g.
+//   "case.json: /design/strokes/2/points is [[0,0,0]]; expected at least two points".
+// Whether points lie on/in the body is checked when the design is computed (it needs the model).
+#include <optional>
+
+#include "cleave/io/case_file.hpp"
+#include "cleave/stress/stress_design.hpp"
+
+namespace cleave {
+
+/// The parsed section, or nullopt when the case has no "design".
+std::optional<StressDesign> parse_case_design(const CaseFile& case_file);
+
+/// The same from the section's JSON value (`at` names where it came from, for messages).
+StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at);
+
+}  // namespace cleave

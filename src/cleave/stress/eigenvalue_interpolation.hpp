@@ -1,0 +1,44 @@
+#pragma once
+// The eigenvalue fields (paper section 6.2): per cell lambda = (Langer, cross, normal) in kPa,
+//   min  w_L |L lambda|^2 + w_C |C lambda - lambda0|^2 + w_E |T (d sigma/d lambda) lambda / h^2|^2
+// (eq. 9; a 1e-10 w_L |lambda|^2 guard keeps it positive definite), solved on the normal equations
+// A^T A lambda = A^T b. The equilibrium rows are divided by h^2 (T is in mm^2) so that every term
+// is a stress in kPa. Free vertices are all vertices (the design is for the unsupported body).
+//
+//   EigenvalueInterpolator interp(volume, weights);                // L^T L (x) I3 once per topology
+//   EigenvalueSolution s = interp.solve(frames, targets, EigenvalueSolver::cholesky, warm_start);
+//
+// Solvers: `cholesky` (default): CHOLMOD supernodal Cholesky; the symbolic analysis is reused
+// between calls because the pattern of A^T A depends only on the topology. `paper_cg`: the
+// paper's plain CG on A^T A (one thread, no preconditioner), started from `warm_start` when it
+// has the right size, to relative residual 1e-12; ComputeError when it does not get there.
+#include <vector>
+
+#include "cleave/grid/linked_volume.hpp"
+#include "cleave/solve/linear_solver.hpp"
+#include "cleave/stress/control_point_targets.hpp"
+#include "cleave/stress/direction_frames.hpp"
+#include "cleave/stress/sparse_cholesky.hpp"
+#include "cleave/stress/stress_design.hpp"
+
+namespace cleave {
+
+struct EigenvalueSolution {
+  std::vector<Vec3> eigenvalues_kPa;  ///< per cell: Langer, cross, normal
+  int iterations = 0;                 ///< CG iterations (0 for Cholesky)
+};
+
+class EigenvalueInterpolator {
+ public:
+  EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights);
+  EigenvalueSolution solve(const std::vector<DirectionFrame>& frames, const std::vector<EigenvalueTarget>& targets,
+                           EigenvalueSolver solver, const std::vector<Vec3>& warm_start = {});
+
+ private:
+  const LinkedVolume& volume_;
+  DesignWeights weights_;
+  Eigen::SparseMatrix<double> smoothness_;  ///< w_L (L^T L) (x) I3 + guard, ColMajor
+  SparseCholesky cholesky_;
+};
+
+}  // namespace cleave

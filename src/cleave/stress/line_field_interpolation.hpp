@@ -1,0 +1,34 @@
+#pragma once
+// Laplacian interpolation of a line field over the cells (paper eqs. 7 to 9 applied to
+// eigenvectors, issue 4 item 2): the unknown per cell is the symmetric tensor X (6 Voigt
+// components, each interpolated independently), found by
+//   min  w_L |L X|^2 + w_C sum over targets |X(cell) - target|^2  (+ a 1e-10 w_L |X|^2 guard)
+// so that cells of a body piece without any target get X = 0 instead of a singular system.
+// Because a target is d d^T, the result is the same for d and -d: no cancellation between
+// strokes drawn in opposite directions.
+//
+//   LineFieldInterpolator interp(volume, weights);          // L^T L once per topology
+//   std::vector<Mat3> x = interp.interpolate(targets);      // numeric factorization + 6 solves
+#include <vector>
+
+#include "cleave/grid/linked_volume.hpp"
+#include "cleave/stress/sparse_cholesky.hpp"
+#include "cleave/stress/stress_design.hpp"
+#include "cleave/stress/stroke_constraints.hpp"
+
+namespace cleave {
+
+class LineFieldInterpolator {
+ public:
+  LineFieldInterpolator(const LinkedVolume& volume, const DesignWeights& weights);
+  /// One interpolated tensor per cell. Targets must name cells of the volume (InputError otherwise).
+  std::vector<Mat3> interpolate(const std::vector<LineTarget>& targets);
+
+ private:
+  Eigen::SparseMatrix<double> smoothness_;  ///< w_L L^T L + guard, ColMajor
+  DesignWeights weights_;
+  CellId cell_count_ = 0;
+  SparseCholesky cholesky_;
+};
+
+}  // namespace cleave

@@ -1,0 +1,35 @@
+#pragma once
+// Sparse Cholesky factorization of a symmetric positive definite matrix (CHOLMOD, supernodal),
+// keeping the symbolic analysis while the sparsity pattern stays the same: the design's systems
+// change values after every edit but never their pattern, so each update is numeric only.
+//
+//   SparseCholesky chol;
+//   chol.factorize(a);            // a: SPD, ColMajor, both triangles stored (only the lower is read)
+//   Eigen::MatrixXd x = chol.solve(b);
+//
+// Throws ComputeError when the matrix is not positive definite.
+#include <Eigen/Core>
+#include <Eigen/SparseCore>
+#include <memory>
+
+namespace cleave {
+
+class SparseCholesky {
+ public:
+  SparseCholesky();
+  ~SparseCholesky();
+  SparseCholesky(SparseCholesky&&) noexcept;
+  SparseCholesky& operator=(SparseCholesky&&) noexcept;
+
+  void factorize(const Eigen::SparseMatrix<double>& a);
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  /// Numeric factorizations that could reuse the previous symbolic analysis.
+  int reused_analyses() const { return reused_; }
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+  int reused_ = 0;
+};
+
+}  // namespace cleave

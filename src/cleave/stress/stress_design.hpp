@@ -1,0 +1,60 @@
+#pragma once
+// What a user designs (paper section 4): Langer-direction strokes and eigenvalue control points,
+// plus the weights of the least-squares interpolation (eqs. 7 to 9) and the finishing steps.
+// Plain data; parsed from the case section "design" (io/case_design.hpp) or built by the studio.
+//
+// Units: positions in mm (model coordinates), eigenvalues in kPa, weights dimensionless.
+#include <vector>
+
+#include "cleave/core/types.hpp"
+
+namespace cleave {
+
+/// Where a stroke lies: on the body surface (its points are snapped onto the surface) or inside
+/// the body (its points are used as given and must lie in a cell; the paper's future work).
+enum class StrokePlacement { surface, interior };
+
+/// A polyline along Langer's lines. Its direction of drawing does not matter (line field).
+struct DesignStroke {
+  std::vector<Vec3> points_mm;  ///< at least 2 points
+  StrokePlacement placement = StrokePlacement::surface;
+};
+
+/// Eigenvalues prescribed at a surface point (paper fig. 4); the normal eigenvalue there is 0.
+struct DesignControlPoint {
+  Vec3 position_mm = Vec3::Zero();
+  double langer_kPa = 20.0;  ///< paper section 7: typical tension along Langer's lines
+  double cross_kPa = 10.0;   ///< and across them
+};
+
+/// Weights of the least-squares terms (eq. 9). The equilibrium rows are T sigma / h^2 (kPa), so
+/// all three terms compare stresses and the weights need no rescaling with the cell size.
+struct DesignWeights {
+  double laplacian = 1.0;      ///< smoothness, L lambda = 0 (eq. 7)
+  double constraint = 1000.0;  ///< strokes and control points, C lambda = lambda0 (eq. 8)
+  double equilibrium = 1.0;    ///< T (d sigma / d lambda) lambda = 0 (eq. 6); 0 = off
+};
+
+/// How the eigenvalue normal equations A^T A lambda = A^T b are solved.
+enum class EigenvalueSolver {
+  cholesky,  ///< default: sparse Cholesky (CHOLMOD supernodal) of A^T A, symbolic analysis reused
+  paper_cg,  ///< reference: the paper's plain conjugate gradients on A^T A, one thread
+};
+
+/// Whether the designed field is made exactly self-balanced afterwards (equilibrate_stress.hpp).
+enum class Equilibration {
+  none,    ///< keep the least-squares design as it is
+  growth,  ///< remove the compatible part of the design's eigenstrain (one elastic solve)
+};
+
+struct StressDesign {
+  std::vector<DesignStroke> strokes;
+  std::vector<DesignControlPoint> control_points;
+  DesignWeights weights;
+  EigenvalueSolver solver = EigenvalueSolver::cholesky;
+  Equilibration equilibration = Equilibration::growth;
+  /// Surface points farther than this many cell sizes from the body surface are refused.
+  double snap_tolerance_cells = 2.0;
+};
+
+}  // namespace cleave

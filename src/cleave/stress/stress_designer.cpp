@@ -1,0 +1,176 @@
+#include "cleave/stress/stress_designer.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <fmt/format.h>
+
+#include "cleave/core/error.hpp"
+#include "cleave/stress/control_point_targets.hpp"
+#include "cleave/stress/eigenvalue_interpolation.hpp"
+#include "cleave/stress/equilibrate_stress.hpp"
+#include "cleave/stress/equilibrium_operator.hpp"
+#include "cleave/stress/line_field_interpolation.hpp"
+#include "cleave/stress/stress_from_frames.hpp"
+#include "cleave/stress/stroke_constraints.hpp"
+
+namespace cleave {
+namespace {
+
+double seconds_since(std::chrono::steady_clock::time_point start) {
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+void check_weights(const DesignWeights& w) {
+  const auto check = [](double value, const char* name, bool positive) {
+    if (!std::isfinite(value) || value < 0.0 || (positive && value == 0.0))
+      throw InputError(fmt::format("design weight '{}' is {}; expected a finite number {}", name, value,
+                                   positive ? "> 0" : ">= 0"));
+  };
+  check(w.laplacian, "laplacian", true);
+  check(w.constraint, "constraint", true);
+  check(w.equilibrium, "equilibrium", false);
+}
+
+bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].placement != b[i].placement || a[i].points_mm != b[i].points_mm) return false;
+  return true;
+}
+
+}  // namespace
+
+struct StressDesigner::Operators {
+  Operators(const TissueModel& model, const DesignWeights& weights)
+      : langer(model.volume, weights),
+        eigenvalues(model.volume, weights),
+        divergence(stress_divergence_matrix(model.volume)),
+        norm(equilibrium_norm(divergence)) {
+    LineFieldInterpolator normal_interp(model.volume, weights);
+    normal_tensors = normal_interp.interpolate(surface_normal_targets(model));
+  }
+  LineFieldInterpolator langer;
+  EigenvalueInterpolator eigenvalues;
+  SparseMatrix divergence;
+  EquilibriumNorm norm;
+  std::vector<Mat3> normal_tensors;
+};
+
+StressDesigner::StressDesigner(const TissueModel& model, StressDesign design) : model_(model) {
+  check_weights(design.weights);
+  if (!std::isfinite(design.snap_tolerance_cells) || design.snap_tolerance_cells <= 0.0)
+    throw InputError(fmt::format("design snap tolerance is {} cells; expected a positive number", design.snap_tolerance_cells));
+  // Validate the inputs before building operators, so that a bad design fails fast.
+  const double tolerance_mm = design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
+  stroke_line_targets(model, design.strokes, tolerance_mm);
+  control_point_targets(model, design.control_points, tolerance_mm);
+  ops_ = std::make_unique<Operators>(model, design.weights);
+  DesignResult next;
+  update_directions(design, next);
+  update_eigenvalues(design, next);
+  finish(design, next);
+  result_ = std::move(next);
+  design_ = std::move(design);
+}
+
+StressDesigner::~StressDesigner() = default;
+
+void StressDesigner::update_directions(const StressDesign& design, DesignResult& out) {
+  const auto start = std::chrono::steady_clock::now();
+  const double tolerance_mm = design.snap_tolerance_cells * model_.volume.grid().cell_size_mm;
+  const std::vector<LineTarget> targets = stroke_line_targets(model_, design.strokes, tolerance_mm);
+  const std::vector<Mat3> langer = ops_->langer.interpolate(targets);
+  out.frames = direction_frames(langer, ops_->normal_tensors);
+  out.timings.directions_s = seconds_since(start);
+}
+
+void StressDesigner::update_eigenvalues(const StressDesign& design, DesignResult& out) {
+  const auto start = std::chrono::steady_clock::now();
+  const double tolerance_mm = design.snap_tolerance_cells * model_.volume.grid().cell_size_mm;
+  const std::vector<EigenvalueTarget> targets = control_point_targets(model_, design.control_points, tolerance_mm);
+  EigenvalueSolution s = ops_->eigenvalues.solve(out.frames, targets, design.solver, out.eigenvalues_kPa);
+  out.eigenvalues_kPa = std::move(s.eigenvalues_kPa);
+  out.eigenvalue_iterations = s.iterations;
+  out.timings.eigenvalues_s = seconds_since(start);
+}
+
+void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
+  out.designed_kPa = stress_from_frames(out.frames, out.eigenvalues_kPa);
+  out.residual_designed = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.designed_kPa);
+  const auto start = std::chrono::steady_clock::now();
+  if (design.equilibration == Equilibration::growth) {
+    out.stress_kPa = equilibrate_stress(model_, out.designed_kPa).stress_kPa;
+  } else {
+    out.stress_kPa = out.designed_kPa;
+  }
+  out.timings.equilibration_s = seconds_since(start);
+  out.residual_final = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.stress_kPa);
+}
+
+void StressDesigner::set_design(StressDesign design) {
+  const DesignWeights& a = design.weights;
+  const DesignWeights& b = design_.weights;
+  if (a.laplacian != b.laplacian || a.constraint != b.constraint || a.equilibrium != b.equilibrium ||
+      design.snap_tolerance_cells != design_.snap_tolerance_cells)
+    throw InputError("design weights or snap tolerance changed; expected the same (build a new StressDesigner for new weights)");
+  // Work on a copy: a failing edit leaves the designer as it was.
+  DesignResult next = result_;
+  next.timings = {};
+  if (!same_strokes(design.strokes, design_.strokes)) update_directions(design, next);
+  update_eigenvalues(design, next);
+  finish(design, next);
+  result_ = std::move(next);
+  design_ = std::move(design);
+}
+
+void StressDesigner::add_stroke(DesignStroke stroke) {
+  StressDesign d = design_;
+  d.strokes.push_back(std::move(stroke));
+  set_design(std::move(d));
+}
+
+void StressDesigner::move_stroke(std::size_t index, DesignStroke stroke) {
+  if (index >= design_.strokes.size())
+    throw InputError(fmt::format("stroke {} does not exist; expected an index below {}", index, design_.strokes.size()));
+  StressDesign d = design_;
+  d.strokes[index] = std::move(stroke);
+  set_design(std::move(d));
+}
+
+void StressDesigner::delete_stroke(std::size_t index) {
+  if (index >= design_.strokes.size())
+    throw InputError(fmt::format("stroke {} does not exist; expected an index below {}", index, design_.strokes.size()));
+  StressDesign d = design_;
+  d.strokes.erase(d.strokes.begin() + static_cast<std::ptrdiff_t>(index));
+  set_design(std::move(d));
+}
+
+void StressDesigner::add_control_point(DesignControlPoint point) {
+  StressDesign d = design_;
+  d.control_points.push_back(point);
+  set_design(std::move(d));
+}
+
+void StressDesigner::move_control_point(std::size_t index, DesignControlPoint point) {
+  if (index >= design_.control_points.size())
+    throw InputError(fmt::format("control point {} does not exist; expected an index below {}", index,
+                                 design_.control_points.size()));
+  StressDesign d = design_;
+  d.control_points[index] = point;
+  set_design(std::move(d));
+}
+
+void StressDesigner::delete_control_point(std::size_t index) {
+  if (index >= design_.control_points.size())
+    throw InputError(fmt::format("control point {} does not exist; expected an index below {}", index,
+                                 design_.control_points.size()));
+  StressDesign d = design_;
+  d.control_points.erase(d.control_points.begin() + static_cast<std::ptrdiff_t>(index));
+  set_design(std::move(d));
+}
+
+DesignResult design_residual_stress(const TissueModel& model, const StressDesign& design) {
+  return StressDesigner(model, design).result();
+}
+
+}  // namespace cleave

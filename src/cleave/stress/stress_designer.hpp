@@ -1,0 +1,80 @@
+#pragma once
+// The residual stress design of one tissue model, kept up to date while the user edits
+// (issue 4, items 1 to 7). It holds the model's operators (Laplacians, T, its norm, the surface
+// normal field, symbolic factorizations) so that each edit only redoes what depends on it:
+//   stroke edits          -> Langer line field, frames, eigenvalues, stress
+//   control point edits   -> eigenvalues, stress (frames are kept)
+// Warm start: the Cholesky solvers reuse their symbolic analysis (the pattern only depends on the
+// topology); the paper CG starts from the previous eigenvalues. An edit gives the same result as
+// a fresh designer with the final design (within solver tolerance).
+//
+//   StressDesigner designer(model, design);         // computes everything; InputError on bad design
+//   designer.add_stroke({{p0, p1, p2}});            // recomputes
+//   designer.move_control_point(0, {q, 25, 12});
+//   const DesignResult& r = designer.result();      // frames, eigenvalues, stress per cell
+//
+// The model must outlive the designer and keep its topology (build a new designer after a cut).
+// Edits that fail validation throw InputError and leave the designer unchanged. Indices out of
+// range are InputErrors too.
+#include <memory>
+#include <vector>
+
+#include "cleave/model/tissue_model.hpp"
+#include "cleave/stress/direction_frames.hpp"
+#include "cleave/stress/stress_design.hpp"
+
+namespace cleave {
+
+/// Wall-clock time of each step of the last update (s); 0 for steps that were not redone.
+struct DesignTimings {
+  double directions_s = 0;    ///< stroke targets, Langer field, orthonormal frames
+  double eigenvalues_s = 0;   ///< eigenvalue least squares
+  double equilibration_s = 0; ///< exact equilibration (when enabled)
+};
+
+struct DesignResult {
+  std::vector<DirectionFrame> frames;    ///< per cell
+  std::vector<Vec3> eigenvalues_kPa;     ///< per cell: Langer, cross, normal (of the design, before equilibration)
+  std::vector<Vec6> designed_kPa;        ///< sigma from frames and eigenvalues (eq. 4)
+  std::vector<Vec6> stress_kPa;          ///< the result: designed_kPa, equilibrated when enabled
+  double residual_designed = 0;          ///< ||T sigma|| / (||T||_2 ||sigma||) of designed_kPa
+  double residual_final = 0;             ///< the same of stress_kPa
+  int eigenvalue_iterations = 0;         ///< paper CG iterations of the last solve (0 for Cholesky)
+  DesignTimings timings;
+};
+
+class StressDesigner {
+ public:
+  StressDesigner(const TissueModel& model, StressDesign design);
+  ~StressDesigner();
+  StressDesigner(const StressDesigner&) = delete;
+  StressDesigner& operator=(const StressDesigner&) = delete;
+
+  const StressDesign& design() const { return design_; }
+  const DesignResult& result() const { return result_; }
+
+  void add_stroke(DesignStroke stroke);
+  void move_stroke(std::size_t index, DesignStroke stroke);  ///< replaces stroke `index`
+  void delete_stroke(std::size_t index);
+  void add_control_point(DesignControlPoint point);
+  void move_control_point(std::size_t index, DesignControlPoint point);
+  void delete_control_point(std::size_t index);
+  /// Replaces the whole design (weights and solver must stay the same: InputError otherwise).
+  void set_design(StressDesign design);
+
+ private:
+  struct Operators;
+  void update_directions(const StressDesign& design, DesignResult& out);
+  void update_eigenvalues(const StressDesign& design, DesignResult& out);
+  void finish(const StressDesign& design, DesignResult& out);
+
+  const TissueModel& model_;
+  StressDesign design_;
+  std::unique_ptr<Operators> ops_;
+  DesignResult result_;
+};
+
+/// One-shot design (a StressDesigner without the edits).
+DesignResult design_residual_stress(const TissueModel& model, const StressDesign& design);
+
+}  // namespace cleave
