@@ -28,7 +28,7 @@ int item_id(const nlohmann::json& edit, const JsonPath& at) {
 template <class Item>
 auto find_item(std::vector<Item>& items, int id, const char* what, const JsonPath& at) {
   auto it = std::find_if(items.begin(), items.end(), [id](const Item& i) { return i.id == id; });
-  if (it == items.end()) throw InputError(fmt::format("{}: no {} with id {}", at.str(), what, id));
+  if (it == items.end()) throw InputError(fmt::format("{}: no {} with id {}", at.file, what, id));
   return it;
 }
 

@@ -1,0 +1,66 @@
+#pragma once
+// The studio's computation side: after every edit it recomputes, in the field worker, what the
+// page shows (the surface, the design fields and the incision preview), and it answers the
+// requests that need the model (exports). It only calls the cleave library; the physics lives
+// there. Results are JSON messages for the page (docs/studio.md), every number finite.
+#include <memory>
+#include <mutex>
+#include <nlohmann/json.hpp>
+#include <string>
+#include <vector>
+
+#include "cleave/cut/body_surface.hpp"
+#include "cleave/cut/cut_plan.hpp"
+#include "cleave/stress/stress_designer.hpp"
+#include "cleave/surface/render_surface.hpp"
+#include "cleave/surface/surface_mesh.hpp"
+#include "studio/field_worker.hpp"
+#include "studio/message_handler.hpp"
+#include "studio/studio_session.hpp"
+
+namespace cleave::studio {
+
+class StudioCompute {
+ public:
+  /// `send` delivers a message to every client (thread safe; called from the worker thread).
+  StudioCompute(const StudioSession& session, std::function<void(std::string)> send);
+  ~StudioCompute();
+
+  /// Starts recomputing for `design` (seq = the session's seq); a newer call supersedes it.
+  void design_changed(const DesignState& design, std::uint64_t seq);
+  /// The latest result message (the mesh and fields) for a newly connected client.
+  std::vector<std::string> welcome_messages() const;
+  /// Writes the latest result in `format` to `file`.
+  void export_result(ExportFormat format, const std::filesystem::path& file) const;
+  /// Blocks until the worker is idle (tests).
+  void wait_idle() { worker_->wait_idle(); }
+
+ private:
+  nlohmann::json compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx);
+  void prepare(const FieldWorker::Context& ctx);
+
+  // Worker-thread state (only the worker touches these).
+  std::unique_ptr<BodySurface> body_surface_;         ///< of the uncut model
+  std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
+  std::unique_ptr<StressDesigner> designer_;
+  std::vector<Vec6> stress_kPa_;                      ///< of the last design (per cell), for exports
+  std::vector<Vec3> displacement_mm_;                 ///< of the last preview (per vertex of preview_model_)
+  std::shared_ptr<TissueModel> preview_model_;        ///< the model cut by the preview and the user's cuts
+  std::unique_ptr<RenderSurface> preview_surface_;
+
+  const StudioSession& session_;
+  std::function<void(std::string)> send_;
+  /// What the latest result exports (shared with the I/O thread under latest_mutex_).
+  struct ExportSnapshot {
+    std::shared_ptr<const TissueModel> model;  ///< cut
+    std::vector<Vec3> displacement_mm;         ///< per vertex of model; empty = at rest
+    std::vector<Vec6> stress_kPa;              ///< per cell; empty = none designed
+    SurfaceMesh mesh;                          ///< deformed render surface
+  };
+  mutable std::mutex latest_mutex_;
+  std::string latest_result_;
+  ExportSnapshot latest_export_;
+  std::unique_ptr<FieldWorker> worker_;
+};
+
+}  // namespace cleave::studio

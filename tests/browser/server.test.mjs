@@ -1,0 +1,150 @@
+// Server safety tests of `cleave studio` without a browser: loopback binding, a second server on
+// the same port, path traversal over HTTP, malformed and oversized WebSocket messages, and a
+// bounded soak (16 concurrent clients editing for SOAK_SECONDS on 127.0.0.1, then every
+// acknowledged edit must be in the state and in the journal after a restart).
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import { spawnSync } from 'node:child_process';
+import http from 'node:http';
+import { freshSessionDir, requireTools, startServer } from './harness.mjs';
+
+const SOAK_SECONDS = 20;  // <= 60 s by design (bounded soak; see docs/studio.md)
+const SOAK_CLIENTS = 16;
+const tools = requireTools();
+let server;
+before(async () => { server = await startServer({ bin: tools.bin, session: freshSessionDir('server') }); });
+after(async () => { await server.stop(); });
+
+function rawGet(port, rawPath) {
+  return new Promise((resolve, reject) => {
+    const req = http.request({ host: '127.0.0.1', port, path: rawPath, method: 'GET' }, (res) => {
+      let body = '';
+      res.on('data', (c) => { body += c; });
+      res.on('end', () => resolve({ status: res.statusCode, body }));
+    });
+    req.on('error', reject);
+    req.end();
+  });
+}
+
+function openSocket(url) {
+  return new Promise((resolve, reject) => {
+    const ws = new WebSocket(url.replace('http', 'ws') + 'ws');
+    const replies = new Map();
+    ws.pending = replies;
+    ws.onmessage = (e) => {
+      const m = JSON.parse(e.data);
+      if (m.req !== undefined && replies.has(m.req)) { replies.get(m.req)(m); replies.delete(m.req); }
+      if (ws.onpush) ws.onpush(m);
+    };
+    ws.onopen = () => resolve(ws);
+    ws.onerror = reject;
+  });
+}
+let nextReq = 1;
+function request(ws, message) {
+  const req = nextReq++;
+  return new Promise((resolve) => { ws.pending.set(req, resolve); ws.send(JSON.stringify({ ...message, req })); });
+}
+
+test('binds to 127.0.0.1 by default and prints the URL', () => {
+  assert.match(server.url, /^http:\/\/127\.0\.0\.1:\d+\/$/);
+});
+
+test('a second server on the same port fails with a clear error', () => {
+  const r = spawnSync(tools.bin, ['studio', '--session', freshSessionDir('second'), '--port', String(server.port)], { encoding: 'utf8', timeout: 60000 });
+  assert.equal(r.status, 2);
+  assert.match(r.stderr, new RegExp(`port ${server.port} is already in use on 127\\.0\\.0\\.1`));
+});
+
+test('static serving and downloads never leave the web root or the session folder', async () => {
+  assert.equal((await rawGet(server.port, '/')).status, 200);
+  assert.equal((await rawGet(server.port, '/vendor/three.module.js')).status, 200);
+  for (const p of ['/../../../../etc/passwd', '/%2e%2e/%2e%2e/etc/passwd', '/js/../../README.md', '/session/../../etc/passwd',
+    '/session/%2e%2e%2fsession.json', '/%00', '/node_modules/three/package.json', '/session/journal.jsonl', '//etc/passwd']) {
+    const r = await rawGet(server.port, p);
+    assert.ok(r.status === 403 || r.status === 404 || r.status === 400, `${p} -> ${r.status}`);
+    assert.ok(!r.body.includes('root:'), `${p} leaked a file`);
+  }
+});
+
+test('malformed, oversized and unknown messages get an error reply and the session stays intact', async () => {
+  const ws = await openSocket(server.url);
+  const before = await request(ws, { cmd: 'get_state' });
+  const cases = [
+    [{ cmd: 'fly' }, /unknown command 'fly'/],
+    [{ cmd: 'add_stroke', points_mm: [[0, 0, 0]] }, /points_mm .*expected an array of 2 to 4096 points/],
+    [{ cmd: 'add_stroke', points_mm: [[0, 0, 0], [1, 'x', 2]] }, /points_mm\/1/],
+    [{ cmd: 'delete_stroke', id: 12345 }, /no stroke with id 12345/],
+    [{ cmd: 'set_control_point', id: 1, langer_kPa: 1e9 }, /no control point with id 1|langer_kPa/],
+    [{ cmd: 'save', file: '../escape.json' }, /outside the session folder/],
+    [{ cmd: 'load', file: '/etc/passwd' }, /outside the session folder/],
+    [{ cmd: 'export', format: 'vtu', file: '../../x.vtu' }, /outside the session folder/],
+    [{ cmd: 'undo' }, /nothing to undo/],
+  ];
+  for (const [message, expected] of cases) {
+    const r = await request(ws, message);
+    assert.equal(r.type, 'error', JSON.stringify(message));
+    assert.match(r.message, expected);
+  }
+  const errors = [];
+  ws.onpush = (m) => { if (m.type === 'error' && m.req === undefined) errors.push(m.message); };
+  ws.send('{not json');
+  ws.send(JSON.stringify({ cmd: 'add_stroke', points_mm: 'x'.repeat(3 << 20) }));
+  await new Promise((resolve) => setTimeout(resolve, 500));
+  assert.ok(errors.some((e) => /invalid JSON/.test(e)), errors.join('\n'));
+  const afterState = await request(ws, { cmd: 'get_state' });
+  assert.equal(afterState.seq, before.seq);
+  assert.deepEqual(afterState.design, before.design);
+  // A message over the 4 MiB limit closes that connection only; the server keeps serving.
+  const big = await openSocket(server.url);
+  const closed = new Promise((resolve) => { big.onclose = resolve; });
+  big.send('x'.repeat((4 << 20) + 16));
+  await closed;
+  assert.equal((await request(ws, { cmd: 'ping' })).type, 'pong');
+  ws.close();
+});
+
+test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknowledged edit`, { timeout: (SOAK_SECONDS + 90) * 1000 }, async () => {
+  const session = freshSessionDir('soak');
+  const soak = await startServer({ bin: tools.bin, session });
+  const acked = [];
+  let errors = 0;
+  try {
+    const clients = await Promise.all(Array.from({ length: SOAK_CLIENTS }, () => openSocket(soak.url)));
+    const deadline = Date.now() + SOAK_SECONDS * 1000;
+    await Promise.all(clients.map(async (ws, c) => {
+      let i = 0;
+      while (Date.now() < deadline) {
+        const add = await request(ws, { cmd: 'add_control_point', position_mm: [c, i, 0], langer_kPa: 1 + (i % 50), cross_kPa: 1 });
+        if (add.type !== 'ack') { errors++; continue; }
+        acked.push(add.seq);
+        // Keep the design small: delete what this client added, by its position.
+        const state = await request(ws, { cmd: 'get_state' });
+        const mine = state.design.control_points.find((p) => p.position_mm[0] === c && p.position_mm[1] === i);
+        if (mine && i % 2 === 0) {
+          const del = await request(ws, { cmd: 'delete_control_point', id: mine.id });
+          if (del.type === 'ack') acked.push(del.seq); else errors++;
+        }
+        i++;
+      }
+    }));
+    const final = await request(clients[0], { cmd: 'get_state' });
+    for (const ws of clients) ws.close();
+    assert.equal(errors, 0);
+    assert.ok(acked.length > SOAK_CLIENTS * 10, `acknowledged edits: ${acked.length}`);
+    assert.equal(new Set(acked).size, acked.length, 'every acknowledged seq is unique');
+    assert.equal(final.seq, Math.max(...acked), 'the state holds every acknowledged edit');
+    await soak.kill();
+    const again = await startServer({ bin: tools.bin, session, model: null });
+    const ws = await openSocket(again.url);
+    const restored = await request(ws, { cmd: 'get_state' });
+    ws.close();
+    await again.stop();
+    assert.equal(restored.seq, final.seq);
+    assert.deepEqual(restored.design, final.design);
+    console.log(`soak: ${acked.length} acknowledged edits by ${SOAK_CLIENTS} clients in ${SOAK_SECONDS} s, all restored after SIGKILL`);
+  } finally {
+    await soak.stop();
+  }
+});

@@ -1,0 +1,246 @@
+// End-to-end tests of `cleave studio` in Debian's chromium (headless, playwright-core):
+// the page against a real server on 127.0.0.1. Run by CTest (browser_e2e) with node --test.
+import { after, before, test } from 'node:test';
+import assert from 'node:assert/strict';
+import fs from 'node:fs';
+import path from 'node:path';
+import { freshSessionDir, launchBrowser, mouseDrag, openStudio, requireTools, screenshot, startServer, surfacePath,
+  waitForResult } from './harness.mjs';
+
+const tools = requireTools();
+let browser;
+before(async () => { browser = await launchBrowser(tools.chromium); });
+after(async () => { await browser.close(); });
+
+async function withStudio(name, fn, options = {}) {
+  const session = options.session ?? freshSessionDir(name);
+  const server = await startServer({ bin: tools.bin, session, ...options });
+  const page = await openStudio(browser.context, server.url);
+  try {
+    await fn({ page, server, session });
+    assert.deepEqual(page.jsErrors, [], 'no JavaScript errors on the page');
+  } finally {
+    await screenshot(page, name).catch(() => {});
+    await page.close();
+    await server.stop();
+  }
+}
+
+const unit = (v) => { const n = Math.hypot(...v); return v.map((x) => x / n); };
+
+test('loads the built-in abdomen and shows its surface with a scale bar', async () => {
+  await withStudio('01-load-abdomen', async ({ page }) => {
+    const r = await page.evaluate(() => window.studio.app.result);
+    const s = await page.evaluate(() => window.studio.app.state);
+    assert.equal(s.model.source, 'abdomen');
+    assert.deepEqual(s.model.resolution, [63, 21, 42]);
+    assert.ok(r.cells > 3000 && r.cells < 63 * 21 * 42, `abdomen cells ${r.cells}`);
+    assert.ok(r.surface.triangles.length >= 3 * 1000, 'a surface with triangles');
+    assert.ok(r.surface.positions_mm.every(Number.isFinite), 'finite positions');
+    assert.match(await page.locator('#scale-bar .label').textContent(), /^\d+ mm$/);
+    assert.equal(await page.locator('#conn').textContent(), 'connected');
+  });
+});
+
+test('a stroke drawn by mouse turns the direction field along it near the stroke', async () => {
+  await withStudio('02-stroke-direction', async ({ page }) => {
+    await page.click('button[data-tool=stroke]');
+    const pts = await surfacePath(page);
+    await mouseDrag(page, pts);
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    const seq = await page.evaluate(() => window.studio.app.state.seq);
+    const r = await waitForResult(page, seq);
+    await page.selectOption('#display', 'glyphs');
+    const stroke = await page.evaluate(() => window.studio.app.state.design.strokes[0].points_mm);
+    assert.ok(stroke.length >= 5, `stroke of ${stroke.length} points`);
+    const dir = r.fields && r.fields.direction;
+    assert.ok(dir, 'the result carries the direction field');
+    // Every surface vertex within two cells of the stroke's middle: direction parallel to the stroke.
+    const mid = Math.floor(stroke.length / 2);
+    const tangent = unit(stroke[mid + 1].map((v, k) => v - stroke[mid - 1][k]));
+    const p = r.surface.positions_mm;
+    let near = 0, aligned = 0;
+    for (let i = 0; i < p.length / 3; i++) {
+      const d = Math.hypot(p[3 * i] - stroke[mid][0], p[3 * i + 1] - stroke[mid][1], p[3 * i + 2] - stroke[mid][2]);
+      if (d > 2 * r.cell_size_mm) continue;
+      near++;
+      const v = unit([dir[3 * i], dir[3 * i + 1], dir[3 * i + 2]]);
+      if (Math.abs(v[0] * tangent[0] + v[1] * tangent[1] + v[2] * tangent[2]) > 0.9) aligned++;
+    }
+    assert.ok(near >= 3, `surface vertices near the stroke: ${near}`);
+    assert.ok(aligned / near >= 0.8, `aligned ${aligned} of ${near}`);
+  });
+});
+
+test('the magnitude tool places a control point and a typed value sets it', async () => {
+  await withStudio('03-control-point', async ({ page }) => {
+    await page.click('button[data-tool=magnitude]');
+    const [x, y] = (await surfacePath(page))[8];
+    const box = await page.locator('#canvas').boundingBox();
+    await page.mouse.click(box.x + x, box.y + y);
+    await page.waitForFunction(() => window.studio.app.state.design.control_points.length === 1);
+    const p0 = await page.evaluate(() => window.studio.app.state.design.control_points[0]);
+    assert.equal(p0.langer_kPa, 20);
+    assert.equal(p0.cross_kPa, 10);
+    await page.fill('#langer-kpa', '32.5');
+    await page.press('#langer-kpa', 'Enter');
+    await page.waitForFunction(() => window.studio.app.state.design.control_points[0].langer_kPa === 32.5);
+    assert.equal(await page.evaluate(() => window.studio.app.state.design.control_points[0].cross_kPa), 10);
+    await page.evaluate(() => document.activeElement.blur());
+  });
+});
+
+test('the round-incision preview opens the incisions once stroke and magnitude are set', async () => {
+  await withStudio('04a-incision-preview', async ({ page }) => {
+    await page.click('button[data-tool=stroke]');
+    const pts = await surfacePath(page);
+    await mouseDrag(page, pts);
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    await page.click('button[data-tool=magnitude]');
+    const box = await page.locator('#canvas').boundingBox();
+    await page.mouse.click(box.x + pts[8][0], box.y + pts[8][1] + 10);
+    await page.waitForFunction(() => window.studio.app.state.design.control_points.length === 1);
+    const seq = await page.evaluate(() => window.studio.app.state.seq);
+    const r = await waitForResult(page, seq);
+    assert.equal(r.design_error, undefined, r.design_error);
+    assert.ok(r.incisions.length >= 5, `preview incisions measured: ${r.incisions.length}`);
+    const opened = r.incisions.filter((i) => i.opening_mm > 0.01);
+    assert.ok(opened.length >= 0.8 * r.incisions.length, `opened ${opened.length} of ${r.incisions.length}`);
+    assert.ok(r.fields.depth.some((d) => d > 0.01), 'the surface is displaced');
+    assert.ok(r.timings_ms.total > 0 && Number.isFinite(r.timings_ms.total));
+    assert.match(await page.locator('#timings').textContent(), /total \d+ ms/);
+    await page.click('button[data-tool=orbit]');
+    await page.selectOption('#display', 'langer');
+  });
+});
+
+test('a scalpel cut drawn by mouse opens and its wound width is reported in mm', async () => {
+  await withStudio('04b-cut-wound', async ({ page }) => {
+    const pts = await surfacePath(page, 200, 20);
+    await page.evaluate((p) => {
+      const a = p.map(([x, y]) => window.studio.pickAt(x, y).point.toArray());
+      return window.studio.send('add_stroke', { points_mm: a });
+    }, pts.map(([x, y]) => [x, y - 40]));
+    await page.evaluate((p) => window.studio.send('add_control_point', { position_mm: window.studio.pickAt(p[0], p[1]).point.toArray(), langer_kPa: 20, cross_kPa: 10 }), pts[10]);
+    await page.click('button[data-tool=cut]');
+    await page.fill('#cut-depth', '4');
+    // Across the stroke direction: a vertical cut through the middle.
+    const [x0, y0] = pts[10];
+    const vertical = Array.from({ length: 13 }, (_, i) => [x0, y0 - 60 + 10 * i]);
+    await mouseDrag(page, vertical);
+    await page.waitForFunction(() => window.studio.app.state.design.cuts.length === 1);
+    const seq = await page.evaluate(() => window.studio.app.state.seq);
+    const r = await waitForResult(page, seq);
+    assert.equal(r.cut_error, undefined, r.cut_error);
+    assert.equal(r.wounds.length, 1);
+    assert.ok(r.wounds[0].width_mm > 0.05 && r.wounds[0].width_mm < 100, `wound width ${r.wounds[0].width_mm} mm`);
+    assert.match(await page.locator('#wound-width').textContent(), /^\d+\.\d mm/);
+    await page.click('#reset-cuts');
+    await page.waitForFunction(() => window.studio.app.state.design.cuts.length === 0);
+    const r2 = await waitForResult(page, seq + 1);
+    assert.equal(r2.wounds.length, 0, 'reset restores the uncut body');
+  });
+});
+
+test('undo and redo restore the design step by step', async () => {
+  await withStudio('04-undo-redo', async ({ page }) => {
+    await page.click('button[data-tool=stroke]');
+    const pts = await surfacePath(page);
+    await mouseDrag(page, pts);
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    await mouseDrag(page, pts.map(([x, y]) => [x, y + 20]));
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 2);
+    await page.click('#undo');
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    await page.click('#undo');
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 0);
+    assert.equal(await page.locator('#undo').isDisabled(), true);
+    await page.click('#redo');
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    const s = await page.evaluate(() => window.studio.app.state);
+    assert.equal(s.can_redo, true);
+    assert.equal(s.seq, 5, 'two strokes, two undos and a redo: five acknowledged edits');
+  });
+});
+
+test('save, reload the page, load: the same design comes back', async () => {
+  await withStudio('05-save-load', async ({ page }) => {
+    await page.click('button[data-tool=stroke]');
+    await mouseDrag(page, await surfacePath(page));
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    await page.evaluate(() => window.studio.send('add_control_point', { position_mm: window.studio.app.state.design.strokes[0].points_mm[3], langer_kPa: 18, cross_kPa: 7 }));
+    const saved = await page.evaluate(() => window.studio.app.state.design);
+    await page.fill('#file-name', 'my-design.json');
+    await page.click('#save');
+    await page.waitForSelector('#files-note a');
+    await page.evaluate(() => window.studio.send('reset_cuts'));
+    await page.evaluate(() => window.studio.send('delete_stroke', { id: window.studio.app.state.design.strokes[0].id }));
+    await page.reload();
+    await page.waitForFunction(() => window.studio && window.studio.app.state && window.studio.app.result);
+    assert.equal(await page.evaluate(() => window.studio.app.state.design.strokes.length), 0);
+    await page.fill('#file-name', 'my-design.json');
+    await page.click('#load');
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    const loaded = await page.evaluate(() => window.studio.app.state.design);
+    assert.deepEqual(loaded.strokes.map((s) => s.points_mm), saved.strokes.map((s) => s.points_mm));
+    assert.deepEqual(loaded.control_points.map(({ position_mm, langer_kPa, cross_kPa }) => ({ position_mm, langer_kPa, cross_kPa })),
+      saved.control_points.map(({ position_mm, langer_kPa, cross_kPa }) => ({ position_mm, langer_kPa, cross_kPa })));
+    // The saved case is the CLI's format, served from the session folder.
+    const text = await page.evaluate(() => fetch('/session/my-design.json').then((r) => r.text()));
+    const doc = JSON.parse(text);
+    assert.equal(doc.model.source, 'abdomen');
+    assert.equal(doc.design.strokes.length, 1);
+  });
+});
+
+test('killing the server (SIGKILL) mid-session loses no acknowledged edit', async () => {
+  const session = freshSessionDir('kill');
+  let acknowledged;
+  {
+    const server = await startServer({ bin: tools.bin, session });
+    const page = await openStudio(browser.context, server.url);
+    await page.click('button[data-tool=stroke]');
+    await mouseDrag(page, await surfacePath(page));
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    // A burst of edits; the kill lands while some are in flight. Count only the acknowledged ones.
+    acknowledged = await page.evaluate(async () => {
+      const acks = [];
+      const p = window.studio.app.state.design.strokes[0].points_mm[2];
+      for (let i = 0; i < 12; i++) {
+        const r = await window.studio.connection.request('add_control_point', { position_mm: p, langer_kPa: 10 + i, cross_kPa: 5 });
+        acks.push(r.seq);
+      }
+      return { seq: acks[acks.length - 1], design: window.studio.app.state.design };
+    });
+    page.evaluate(() => { for (let i = 0; i < 20; i++) window.studio.connection.request('add_control_point', { position_mm: window.studio.app.state.design.control_points[0].position_mm, langer_kPa: 50 + i }).catch(() => {}); });
+    await server.kill();
+    await screenshot(page, '06-before-kill');
+    await page.close();
+  }
+  const restarted = await startServer({ bin: tools.bin, session, model: null });
+  try {
+    const page = await openStudio(browser.context, restarted.url);
+    const state = await page.evaluate(() => window.studio.app.state);
+    assert.ok(state.seq >= acknowledged.seq, `restored seq ${state.seq} >= acknowledged ${acknowledged.seq}`);
+    for (const p of acknowledged.design.control_points)
+      assert.ok(state.design.control_points.some((q) => q.id === p.id && q.langer_kPa === p.langer_kPa), `control point ${p.id} kept`);
+    assert.deepEqual(state.design.strokes, acknowledged.design.strokes);
+    assert.match(restarted.output(), /edits restored/);
+    await screenshot(page, '06-after-restart');
+    await page.close();
+  } finally {
+    await restarted.stop();
+  }
+});
+
+test('two pages on one session see each other\'s edits', async () => {
+  await withStudio('07-two-clients', async ({ page, server }) => {
+    const other = await openStudio(browser.context, server.url);
+    await page.click('button[data-tool=stroke]');
+    await mouseDrag(page, await surfacePath(page));
+    await other.waitForFunction(() => window.studio.app.state.design.strokes.length === 1);
+    await other.evaluate(() => window.studio.send('undo'));
+    await page.waitForFunction(() => window.studio.app.state.design.strokes.length === 0);
+    await other.close();
+  });
+});

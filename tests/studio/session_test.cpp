@@ -1,0 +1,166 @@
+// Sessions and messages: edits with undo/redo, replay after a restart, save/load round trips,
+// exact error replies, and the worker that drops stale work.
+#include <gtest/gtest.h>
+
+#include <atomic>
+#include <chrono>
+#include <filesystem>
+#include <thread>
+#include <unistd.h>
+
+#include "cleave/core/error.hpp"
+#include "studio/field_worker.hpp"
+#include "studio/message_handler.hpp"
+#include "studio/studio_session.hpp"
+
+namespace cleave::studio {
+namespace {
+
+using nlohmann::json;
+
+std::filesystem::path fresh_folder(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cleave-session-test-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+json small_plate() { return {{"cleave_case", 1}, {"model", {{"source", "plate"}, {"resolution", {8, 8, 2}}}}}; }
+
+json stroke(double y) { return {{"cmd", "add_stroke"}, {"points_mm", {{0, y, 0}, {5, y, 0}, {10, y, 1}}}}; }
+
+json reply(StudioSession& s, const json& message) { return handle_message(s, message.dump(), nullptr).reply; }
+
+TEST(StudioSession, EditsUndoRedoAndIdsNeverReused) {
+  StudioSession s(fresh_folder("edits"), small_plate());
+  EXPECT_EQ(s.apply_edit(stroke(1)), 1u);
+  EXPECT_EQ(s.apply_edit(stroke(2)), 2u);
+  ASSERT_EQ(s.design().strokes.size(), 2u);
+  EXPECT_EQ(s.design().strokes[0].id, 1);
+  EXPECT_EQ(s.design().strokes[1].id, 2);
+  s.apply_edit({{"cmd", "undo"}});
+  EXPECT_EQ(s.design().strokes.size(), 1u);
+  s.apply_edit(stroke(3));  // drops the redo branch; must not reuse id 2
+  ASSERT_EQ(s.design().strokes.size(), 2u);
+  EXPECT_EQ(s.design().strokes[1].id, 3);
+  EXPECT_FALSE(s.history().can_redo());
+  s.apply_edit({{"cmd", "move_stroke"}, {"id", 3}, {"offset_mm", {1, 0, 0}}});
+  EXPECT_DOUBLE_EQ(s.design().strokes[1].points_mm[2].x(), 11.0);
+  s.apply_edit({{"cmd", "undo"}});
+  EXPECT_DOUBLE_EQ(s.design().strokes[1].points_mm[2].x(), 10.0);
+  s.apply_edit({{"cmd", "redo"}});
+  EXPECT_DOUBLE_EQ(s.design().strokes[1].points_mm[2].x(), 11.0);
+  EXPECT_EQ(s.seq(), 7u);
+}
+
+TEST(StudioSession, RestartReplaysTheJournalToTheSameState) {
+  const auto folder = fresh_folder("replay");
+  DesignState before;
+  std::uint64_t seq = 0;
+  {
+    StudioSession s(folder, small_plate());
+    s.apply_edit(stroke(1));
+    s.apply_edit({{"cmd", "add_control_point"}, {"position_mm", {4, 4, 1}}, {"langer_kPa", 25}});
+    s.apply_edit({{"cmd", "set_control_point"}, {"id", 2}, {"cross_kPa", 7.5}});
+    s.apply_edit(stroke(2));
+    s.apply_edit({{"cmd", "undo"}});
+    s.apply_edit({{"cmd", "add_cut"}, {"kind", "flap"}, {"path_mm", {{1, 1, 1}, {6, 1, 1}, {6, 6, 1}}}, {"depth_mm", 2}});
+    before = s.design();
+    seq = s.seq();
+  }
+  StudioSession again(folder, std::nullopt);  // no model argument: the folder's session
+  EXPECT_EQ(again.seq(), seq);
+  EXPECT_EQ(to_json(again.design()), to_json(before));
+  EXPECT_EQ(again.design().control_points[0].cross_kPa, 7.5);
+  EXPECT_EQ(again.design().cuts[0].kind, CutKind::flap);
+  EXPECT_TRUE(again.history().can_redo()) << "the undone stroke can still be redone after a restart";
+}
+
+TEST(StudioSession, AnotherModelOnAFolderWithEditsIsRefused) {
+  const auto folder = fresh_folder("model");
+  {
+    StudioSession s(folder, small_plate());
+    s.apply_edit(stroke(1));
+  }
+  json other = small_plate();
+  other["model"]["resolution"] = {6, 6, 2};
+  EXPECT_THROW(StudioSession(folder, other), InputError);
+}
+
+TEST(StudioSession, SaveAndLoadRoundTripTheDesign) {
+  StudioSession s(fresh_folder("save"), small_plate());
+  s.apply_edit(stroke(1));
+  s.apply_edit({{"cmd", "add_control_point"}, {"position_mm", {4, 4, 1}}, {"langer_kPa", 18}, {"cross_kPa", 9}});
+  const DesignState saved = s.design();
+  EXPECT_EQ(reply(s, {{"cmd", "save"}, {"file", "a.json"}})["type"], "saved");
+  s.apply_edit({{"cmd", "delete_stroke"}, {"id", 1}});
+  EXPECT_EQ(reply(s, {{"cmd", "load"}, {"file", "a.json"}})["type"], "ack");
+  ASSERT_EQ(s.design().strokes.size(), 1u);
+  EXPECT_EQ(s.design().strokes[0].points_mm, saved.strokes[0].points_mm);
+  EXPECT_EQ(s.design().control_points[0].langer_kPa, 18);
+  EXPECT_GT(s.design().strokes[0].id, 2) << "loaded items get fresh ids";
+  s.apply_edit({{"cmd", "undo"}});
+  EXPECT_TRUE(s.design().strokes.empty()) << "loading is one undoable edit";
+}
+
+TEST(MessageHandler, ErrorsAreOneLineAndLeaveTheSessionUnchanged) {
+  StudioSession s(fresh_folder("errors"), small_plate());
+  s.apply_edit(stroke(1));
+  const json before = s.state_message();
+  const auto error_of = [&](const std::string& text) {
+    const MessageOutcome out = handle_message(s, text, nullptr);
+    EXPECT_EQ(out.reply["type"], "error") << text;
+    EXPECT_FALSE(out.design_changed);
+    return out.reply.value("message", std::string());
+  };
+  EXPECT_EQ(error_of(R"({"cmd":"fly","req":7})"),
+            "unknown command 'fly'; expected one of hello, get_state, ping, undo, redo, save, load, export, add_stroke, "
+            "move_stroke, delete_stroke, add_control_point, set_control_point, delete_control_point, add_cut, delete_cut, "
+            "reset_cuts");
+  EXPECT_EQ(error_of(R"({"cmd":"add_stroke","points_mm":[[0,0,0]]})"),
+            "message: /points_mm is 1; expected an array of 2 to 4096 points [x, y, z] in mm");
+  EXPECT_EQ(error_of(R"({"cmd":"delete_stroke","id":99})"), "message: no stroke with id 99");
+  EXPECT_EQ(error_of(R"({"cmd":"add_control_point","position_mm":[0,0,0],"langer_kPa":1e9})"),
+            "message: /langer_kPa is 1000000000; expected an eigenvalue in kPa");
+  EXPECT_EQ(error_of(R"({"cmd":"add_cut","path_mm":[[0,0,0],[1,0,0]],"depth_mm":-1})"),
+            "message: /depth_mm is -1; expected a depth in mm");
+  EXPECT_EQ(error_of(R"([1,2])"), "message: expected a JSON object {\"cmd\": ...}");
+  EXPECT_NE(error_of("{oops").find("message: invalid JSON at byte 2"), std::string::npos);
+  EXPECT_EQ(error_of(std::string(kMaxMessageBytes + 1, ' ')), "message of 4194305 bytes is over the limit of 4194304 bytes");
+  EXPECT_EQ(error_of(R"({"cmd":"save","file":"../../etc/x.json"})"),
+            "save: file '../../etc/x.json' is outside the session folder; expected a file name such as design.json");
+  EXPECT_EQ(error_of(R"({"cmd":"export","format":"stl","file":"a.stl"})"),
+            "export: /format is \"stl\"; expected \"vtu\", \"ply\" or \"gltf\"");
+  EXPECT_EQ(error_of(R"({"cmd":"redo"})"), "redo: nothing to redo");
+  EXPECT_EQ(s.state_message(), before);
+  const json r = reply(s, {{"cmd", "ping"}, {"req", "abc"}});
+  EXPECT_EQ(r["type"], "pong");
+  EXPECT_EQ(r["req"], "abc");
+}
+
+TEST(FieldWorker, NewerJobsSupersedeOlderOnesAndOnlyCurrentResultsArePublished) {
+  std::mutex m;
+  std::vector<std::uint64_t> published;
+  std::atomic<bool> release{false};
+  FieldWorker worker([&](FieldWorker::Result r) {
+    std::lock_guard lock(m);
+    published.push_back(r.generation);
+  });
+  // Job 1 blocks until released; jobs 2..9 queue up behind it and replace each other.
+  worker.submit([&](const FieldWorker::Context& ctx) {
+    while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    return json{{"type", "result"}, {"g", ctx.generation}};
+  });
+  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  std::uint64_t last = 0;
+  for (int i = 0; i < 8; ++i)
+    last = worker.submit([](const FieldWorker::Context& ctx) { return json{{"type", "result"}, {"g", ctx.generation}}; });
+  release = true;
+  worker.wait_idle();
+  EXPECT_EQ(last, 9u);
+  EXPECT_EQ(worker.jobs_started(), 2u) << "the job in flight and the newest one; none of the stale ones";
+  ASSERT_EQ(published.size(), 1u) << "the superseded job's result is discarded";
+  EXPECT_EQ(published[0], 9u);
+}
+
+}  // namespace
+}  // namespace cleave::studio

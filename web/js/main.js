@@ -1,0 +1,294 @@
+// The studio page: wires the connection, the view and the tools. window.studio exposes the
+// state for the end-to-end tests (tests/browser).
+import * as THREE from 'three';
+import { Connection } from './connection.js';
+import { Viewer } from './viewer.js';
+
+const $ = (id) => document.getElementById(id);
+const viewer = new Viewer($('canvas'));
+const app = {
+  state: null,          // last "state" message (design, seq, can_undo, can_redo)
+  result: null,         // last "result" message (surface, fields, timings)
+  resultCount: 0,
+  tool: 'orbit',
+  selected: { kind: null, id: null },
+  wound: null,
+  lastError: null,
+  frames: 0,
+};
+window.studio = { app, viewer, pickAt: (x, y) => viewer.pick(x, y), screenOf: (p) => viewer.screenOf(p) };
+
+function setMessage(text, isError = false) {
+  $('message').textContent = text;
+  $('message').className = isError ? 'error' : '';
+  if (isError) app.lastError = text;
+}
+
+function onMessage(m) {
+  if (m.type === 'state') {
+    app.state = m;
+    refreshDesign();
+  } else if (m.type === 'result') {
+    app.result = m;
+    app.resultCount++;
+    viewer.setResult(m);
+    refreshDesign();
+    const t = m.timings_ms || {};
+    $('timings').textContent = Object.entries(t).map(([k, v]) => `${k} ${v.toFixed(0)} ms`).join(' · ');
+    $('progress').hidden = true;
+    if (m.wounds && m.wounds.length) {
+      app.wound = m.wounds[m.wounds.length - 1];
+      $('wound-width').textContent = `${app.wound.width_mm.toFixed(1)} mm`;
+    } else {
+      app.wound = null;
+      $('wound-width').textContent = '–';
+    }
+    $('model-info').textContent = `${app.state ? app.state.model.source : ''} · ${m.cells} cells · ${m.cell_size_mm.toFixed(2)} mm`;
+  } else if (m.type === 'frame') {
+    app.frames++;
+    if (viewer.mesh && m.positions_mm && m.positions_mm.length === viewer.mesh.geometry.attributes.position.array.length) {
+      viewer.mesh.geometry.attributes.position.array.set(m.positions_mm);
+      viewer.mesh.geometry.attributes.position.needsUpdate = true;
+      viewer.mesh.geometry.computeVertexNormals();
+    }
+    if (m.width_mm !== undefined) $('wound-width').textContent = `${m.width_mm.toFixed(1)} mm (t = ${(m.time_s * 1000).toFixed(0)} ms)`;
+  } else if (m.type === 'progress') {
+    $('progress').hidden = false;
+    $('progress').querySelector('.fill').style.width = `${(100 * m.fraction).toFixed(0)}%`;
+    $('progress').querySelector('.text').textContent = `${m.stage}…`;
+  } else if (m.type === 'error') {
+    setMessage(m.message, true);
+  }
+}
+
+const connection = new Connection(`ws://${location.host}/ws`, onMessage, (up) => {
+  $('conn').textContent = up ? 'connected' : 'offline';
+  $('conn').className = up ? 'good' : 'bad';
+});
+window.studio.connection = connection;
+
+async function send(cmd, fields = {}) {
+  try {
+    const reply = await connection.request(cmd, fields);
+    setMessage(reply.type === 'ack' ? `${cmd}: done (edit ${reply.seq})` : `${cmd}: ${reply.type}`);
+    return reply;
+  } catch (e) {
+    setMessage(e.message, true);
+    throw e;
+  }
+}
+window.studio.send = send;
+
+// --- design list and overlays --------------------------------------------------------------
+/// The local tensor frame at a surface point: normal, Langer direction, cross direction.
+function frameAt(position) {
+  let normal = [0, 0, 1], langer = [1, 0, 0];
+  if (viewer.mesh && app.result) {
+    const pos = viewer.mesh.geometry.attributes.position, nrm = viewer.mesh.geometry.attributes.normal;
+    let best = 0, bestD = Infinity;
+    for (let i = 0; i < pos.count; i++) {
+      const dx = pos.array[3 * i] - position[0], dy = pos.array[3 * i + 1] - position[1], dz = pos.array[3 * i + 2] - position[2];
+      const d = dx * dx + dy * dy + dz * dz;
+      if (d < bestD) { bestD = d; best = i; }
+    }
+    normal = [nrm.array[3 * best], nrm.array[3 * best + 1], nrm.array[3 * best + 2]];
+    const dir = app.result.fields && app.result.fields.direction;
+    if (dir) langer = [dir[3 * best], dir[3 * best + 1], dir[3 * best + 2]];
+  }
+  const n = new THREE.Vector3(...normal).normalize();
+  let l = new THREE.Vector3(...langer);
+  l.addScaledVector(n, -l.dot(n));
+  if (l.lengthSq() < 1e-8) l = new THREE.Vector3(1, 0, 0).cross(n).lengthSq() > 1e-4 ? new THREE.Vector3(1, 0, 0).cross(n) : new THREE.Vector3(0, 1, 0).cross(n);
+  l.normalize();
+  const c = n.clone().cross(l).normalize();
+  return { normal: n.toArray(), langer: l.toArray(), cross: c.toArray() };
+}
+window.studio.frameAt = frameAt;
+
+function refreshDesign() {
+  if (!app.state) return;
+  const d = app.state.design;
+  $('seq').textContent = `edits ${app.state.seq}`;
+  $('undo').disabled = !app.state.can_undo;
+  $('redo').disabled = !app.state.can_redo;
+  const list = (el, items, kind, label) => {
+    $(el).replaceChildren(...items.map((item) => {
+      const li = document.createElement('li');
+      li.dataset.id = item.id;
+      li.className = app.selected.kind === kind && app.selected.id === item.id ? 'selected' : '';
+      li.append(label(item));
+      const del = document.createElement('button');
+      del.textContent = '×';
+      del.title = 'delete';
+      del.onclick = (e) => { e.stopPropagation(); send(`delete_${kind}`, { id: item.id }); };
+      li.append(del);
+      li.onclick = () => select(kind, item.id);
+      return li;
+    }));
+  };
+  list('stroke-list', d.strokes, 'stroke', (s) => `Stroke ${s.id} · ${s.points_mm.length} pts`);
+  list('point-list', d.control_points, 'control_point', (p) => `Point ${p.id} · ${p.langer_kPa} / ${p.cross_kPa} kPa`);
+  list('cut-list', d.cuts, 'cut', (c) => `${c.kind === 'flap' ? 'Flap' : 'Cut'} ${c.id} · ${c.depth_mm} mm deep`);
+  $('stroke-count').textContent = d.strokes.length;
+  $('point-count').textContent = d.control_points.length;
+  $('cut-count').textContent = d.cuts.length;
+  const point = d.control_points.find((p) => app.selected.kind === 'control_point' && p.id === app.selected.id);
+  $('point-editor').hidden = !point;
+  if (point && document.activeElement !== $('langer-kpa') && document.activeElement !== $('cross-kpa')) {
+    $('langer-kpa').value = point.langer_kPa;
+    $('cross-kpa').value = point.cross_kPa;
+  }
+  viewer.setDesign(d, app.selected.id, (p) => frameAt(p.position_mm));
+}
+
+function select(kind, id) {
+  app.selected = { kind, id };
+  refreshDesign();
+}
+
+// --- tools -----------------------------------------------------------------------------------
+function setTool(tool) {
+  app.tool = tool;
+  for (const b of document.querySelectorAll('button.tool')) b.classList.toggle('active', b.dataset.tool === tool);
+  viewer.controls.enabled = tool === 'orbit';
+  $('hint').textContent = {
+    orbit: 'drag: orbit · right-drag: pan · wheel: zoom',
+    stroke: 'press and drag on the surface to draw a Langer stroke · drag a stroke with Shift to move it',
+    magnitude: 'click on the surface to place a control point · drag an arrow tip to change its eigenvalue',
+    cut: 'press and drag on the surface to cut · choose scalpel or flap and the depth on the right',
+  }[tool];
+}
+for (const b of document.querySelectorAll('button.tool')) b.onclick = () => setTool(b.dataset.tool);
+setTool('orbit');
+
+const canvas = $('canvas');
+let drag = null;
+const local = (e) => { const r = canvas.getBoundingClientRect(); return [e.clientX - r.left, e.clientY - r.top]; };
+
+function nearestStroke(point) {
+  let best = null, bestD = Infinity;
+  for (const s of app.state.design.strokes)
+    for (const p of s.points_mm) {
+      const d = Math.hypot(p[0] - point.x, p[1] - point.y, p[2] - point.z);
+      if (d < bestD) { bestD = d; best = s; }
+    }
+  return bestD < 3 * ((app.result && app.result.cell_size_mm) || 1) ? best : null;
+}
+
+function arrowUnder(x, y) {
+  // The tip of a control-point arrow within 12 px of (x, y).
+  for (const p of app.state.design.control_points) {
+    const f = frameAt(p.position_mm);
+    for (const axis of ['langer', 'cross']) {
+      const value = Math.max(0.5, Math.abs(axis === 'langer' ? p.langer_kPa : p.cross_kPa));
+      const tip = p.position_mm.map((v, k) => v + f[axis][k] * value * viewer.overlayScale);
+      const [sx, sy] = viewer.screenOf(tip);
+      if (Math.hypot(sx - x, sy - y) < 12) return { point: p, axis, frame: f };
+    }
+  }
+  return null;
+}
+
+canvas.addEventListener('pointerdown', (e) => {
+  if (app.tool === 'orbit' || e.button !== 0 || !app.state) return;
+  const [x, y] = local(e);
+  if (app.tool === 'magnitude') {
+    const arrow = arrowUnder(x, y);
+    if (arrow) { drag = { kind: 'arrow', ...arrow }; canvas.setPointerCapture(e.pointerId); return; }
+  }
+  const hit = viewer.pick(x, y);
+  if (!hit) return;
+  if (app.tool === 'stroke' && e.shiftKey) {
+    const s = nearestStroke(hit.point);
+    if (s) { select('stroke', s.id); drag = { kind: 'move', stroke: s, start: hit.point }; canvas.setPointerCapture(e.pointerId); }
+    return;
+  }
+  if (app.tool === 'magnitude') {
+    send('add_control_point', { position_mm: hit.point.toArray(), langer_kPa: 20, cross_kPa: 10 })
+      .then(() => { const pts = app.state.design.control_points; if (pts.length) select('control_point', pts[pts.length - 1].id); })
+      .catch(() => {});
+    return;
+  }
+  drag = { kind: app.tool, points: [hit.point.toArray()] };
+  canvas.setPointerCapture(e.pointerId);
+});
+
+canvas.addEventListener('pointermove', (e) => {
+  if (!drag) return;
+  const [x, y] = local(e);
+  if (drag.kind === 'arrow') {
+    // Project the pointer onto the arrow's line on screen: the eigenvalue is the tip's distance.
+    const p = drag.point.position_mm, dir = drag.frame[drag.axis];
+    const [ox, oy] = viewer.screenOf(p);
+    const [tx, ty] = viewer.screenOf(p.map((v, k) => v + dir[k] * viewer.overlayScale));
+    const ux = tx - ox, uy = ty - oy, len2 = ux * ux + uy * uy;
+    if (len2 > 1e-6) drag.value = Math.max(0, Math.round((((x - ox) * ux + (y - oy) * uy) / len2) * 2) / 2);
+    return;
+  }
+  const hit = viewer.pick(x, y);
+  if (!hit) return;
+  if (drag.kind === 'move') { drag.end = hit.point; return; }
+  const last = drag.points[drag.points.length - 1];
+  const spacing = 0.5 * ((app.result && app.result.cell_size_mm) || 1);
+  if (Math.hypot(hit.point.x - last[0], hit.point.y - last[1], hit.point.z - last[2]) >= spacing) {
+    drag.points.push(hit.point.toArray());
+    viewer.setDesign({ ...app.state.design, strokes: [...app.state.design.strokes, ...(drag.kind === 'stroke' ? [{ id: -1, points_mm: drag.points.length > 1 ? drag.points : [last, last] }] : [])],
+      cuts: [...app.state.design.cuts, ...(drag.kind === 'cut' && drag.points.length > 1 ? [{ id: -1, kind: $('cut-kind').value, path_mm: drag.points }] : [])] },
+      app.selected.id, (p) => frameAt(p.position_mm));
+  }
+});
+
+canvas.addEventListener('pointerup', () => {
+  const d = drag;
+  drag = null;
+  if (!d) return;
+  if (d.kind === 'arrow') {
+    if (d.value !== undefined) send('set_control_point', { id: d.point.id, [d.axis === 'langer' ? 'langer_kPa' : 'cross_kPa']: d.value }).catch(() => {});
+    return;
+  }
+  if (d.kind === 'move') {
+    if (d.end) send('move_stroke', { id: d.stroke.id, offset_mm: [d.end.x - d.start.x, d.end.y - d.start.y, d.end.z - d.start.z] }).catch(() => {});
+    return;
+  }
+  if (d.points.length < 2) { refreshDesign(); return; }
+  if (d.kind === 'stroke') send('add_stroke', { points_mm: d.points }).catch(() => {});
+  if (d.kind === 'cut') send('add_cut', { kind: $('cut-kind').value, path_mm: d.points, depth_mm: Number($('cut-depth').value) }).catch(() => {});
+});
+
+// --- panel and toolbar ------------------------------------------------------------------------
+const setValue = (key) => () => {
+  if (app.selected.kind !== 'control_point') return;
+  const v = Number($(key === 'langer_kPa' ? 'langer-kpa' : 'cross-kpa').value);
+  if (Number.isFinite(v)) send('set_control_point', { id: app.selected.id, [key]: v }).catch(() => {});
+};
+$('langer-kpa').addEventListener('change', setValue('langer_kPa'));
+$('cross-kpa').addEventListener('change', setValue('cross_kPa'));
+$('undo').onclick = () => send('undo').catch(() => {});
+$('redo').onclick = () => send('redo').catch(() => {});
+$('reset-view').onclick = () => viewer.resetView();
+$('reset-cuts').onclick = () => send('reset_cuts').catch(() => {});
+$('display').onchange = () => viewer.setDisplay($('display').value);
+$('save').onclick = () => send('save', { file: $('file-name').value }).then(() => { $('files-note').innerHTML = `saved <a href="/session/${encodeURIComponent($('file-name').value)}">${$('file-name').value}</a>`; }).catch(() => {});
+$('load').onclick = () => send('load', { file: $('file-name').value }).catch(() => {});
+$('export').onchange = () => {
+  const format = $('export').value;
+  $('export').value = '';
+  if (!format) return;
+  const file = `export.${format}`;
+  send('export', { format, file }).then(() => { $('files-note').innerHTML = `exported <a href="/session/${file}" download>${file}</a>`; }).catch(() => {});
+};
+$('screenshot').onclick = () => {
+  const a = document.createElement('a');
+  a.href = viewer.screenshot();
+  a.download = 'cleave-studio.png';
+  a.click();
+};
+window.addEventListener('keydown', (e) => {
+  if (e.target.tagName === 'INPUT') return;
+  if ((e.ctrlKey || e.metaKey) && e.key === 'z') { e.preventDefault(); $('undo').click(); return; }
+  if ((e.ctrlKey || e.metaKey) && e.key === 'y') { e.preventDefault(); $('redo').click(); return; }
+  if (e.key === 'Delete' && app.selected.id) { send(`delete_${app.selected.kind}`, { id: app.selected.id }).catch(() => {}); return; }
+  const tools = { o: 'orbit', s: 'stroke', m: 'magnitude', c: 'cut' };
+  if (tools[e.key]) setTool(tools[e.key]);
+  if (e.key === 'r') viewer.resetView();
+});
