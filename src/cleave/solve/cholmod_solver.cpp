@@ -1,0 +1,124 @@
+#include "cleave/solve/cholmod_solver.hpp"
+
+#include <cholmod.h>
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <vector>
+
+#include "cleave/core/error.hpp"
+#include "cleave/solve/sparse_multiply.hpp"
+
+namespace cleave {
+namespace {
+
+class CholmodSolver final : public LinearSolver {
+ public:
+  explicit CholmodSolver(const SolveSettings& settings) : settings_(settings) {
+    cholmod_start(&common_);
+    common_.supernodal = CHOLMOD_SUPERNODAL;
+    common_.print = 0;
+    common_.error_handler = nullptr;
+  }
+  ~CholmodSolver() override {
+    if (factor_ != nullptr) cholmod_free_factor(&factor_, &common_);
+    cholmod_finish(&common_);
+  }
+  CholmodSolver(const CholmodSolver&) = delete;
+  CholmodSolver& operator=(const CholmodSolver&) = delete;
+
+  void setup(const SparseMatrix& a, const LinkedVolume& /*topology*/) override {
+    a_ = a;
+    a_.makeCompressed();
+    const auto n = static_cast<std::size_t>(a_.rows());
+    // A symmetric CSR matrix read as CSC is the same matrix; stype 1 reads its upper triangle.
+    cholmod_sparse view{};
+    view.nrow = n;
+    view.ncol = n;
+    view.nzmax = static_cast<std::size_t>(a_.nonZeros());
+    view.p = a_.outerIndexPtr();
+    view.i = a_.innerIndexPtr();
+    view.x = a_.valuePtr();
+    view.stype = 1;
+    view.itype = CHOLMOD_INT;
+    view.xtype = CHOLMOD_REAL;
+    view.dtype = CHOLMOD_DOUBLE;
+    view.sorted = 1;
+    view.packed = 1;
+
+    const bool same_pattern = factor_ != nullptr && pattern_outer_.size() == n + 1 &&
+                              std::equal(pattern_outer_.begin(), pattern_outer_.end(), a_.outerIndexPtr()) &&
+                              pattern_inner_.size() == view.nzmax &&
+                              std::equal(pattern_inner_.begin(), pattern_inner_.end(), a_.innerIndexPtr());
+    if (!same_pattern) {
+      if (factor_ != nullptr) cholmod_free_factor(&factor_, &common_);
+      factor_ = cholmod_analyze(&view, &common_);
+      if (factor_ == nullptr) throw ComputeError(fmt::format("cholmod: analysis failed (status {})", common_.status));
+      pattern_outer_.assign(a_.outerIndexPtr(), a_.outerIndexPtr() + n + 1);
+      pattern_inner_.assign(a_.innerIndexPtr(), a_.innerIndexPtr() + view.nzmax);
+    }
+    cholmod_factorize(&view, factor_, &common_);
+    if (common_.status == CHOLMOD_NOT_POSDEF || factor_->minor < n) {
+      const std::size_t minor = factor_->minor;
+      const int dof = minor < n && factor_->Perm != nullptr ? static_cast<const int*>(factor_->Perm)[minor] : -1;
+      pattern_outer_.clear();  // force a fresh analysis next time
+      cholmod_free_factor(&factor_, &common_);
+      throw ComputeError(fmt::format(
+          "cholmod: matrix is not positive definite (pivot {} of {} fails, dof {} of vertex {}); a piece without fixed "
+          "vertices leaves rigid motions free",
+          minor, n, dof, dof >= 0 ? dof / 3 : -1));
+    }
+    if (common_.status < CHOLMOD_OK) throw ComputeError(fmt::format("cholmod: factorization failed (status {})", common_.status));
+  }
+
+  SolveReport solve(const Vector& b, Vector& x) override {
+    SolveReport report;
+    if (factor_ == nullptr) throw ComputeError("cholmod: solve called before a successful setup");
+    if (b.size() != a_.rows())
+      throw InputError(fmt::format("cholmod: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));
+    const double b_norm = b.norm();
+    if (x.size() != b.size() || !x.allFinite()) x = Vector::Zero(b.size());
+    if (!(b_norm > 0)) {
+      x.setZero();
+      report.converged = std::isfinite(b_norm);
+      return report;
+    }
+    cholmod_dense rhs{};
+    rhs.nrow = static_cast<std::size_t>(b.size());
+    rhs.ncol = 1;
+    rhs.nzmax = rhs.nrow;
+    rhs.d = rhs.nrow;
+    rhs.x = const_cast<double*>(b.data());  // cholmod_solve only reads it
+    rhs.xtype = CHOLMOD_REAL;
+    rhs.dtype = CHOLMOD_DOUBLE;
+    cholmod_dense* solution = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common_);
+    if (solution != nullptr) {
+      const Eigen::Map<const Vector> values(static_cast<const double*>(solution->x), b.size());
+      if (values.allFinite()) x = values;
+      cholmod_free_dense(&solution, &common_);
+    }
+    report.iterations = 1;
+    Vector r;
+    residual(a_, b, x, r);
+    report.relative_residual = r.norm() / b_norm;
+    report.converged = report.relative_residual <= settings_.relative_tolerance;
+    return report;
+  }
+
+  std::string_view name() const override { return "cholmod"; }
+
+ private:
+  SolveSettings settings_;
+  SparseMatrix a_;
+  cholmod_common common_{};
+  cholmod_factor* factor_ = nullptr;
+  std::vector<int> pattern_outer_, pattern_inner_;
+};
+
+}  // namespace
+
+std::unique_ptr<LinearSolver> make_cholmod_solver(const SolveSettings& settings) {
+  return std::make_unique<CholmodSolver>(settings);
+}
+
+}  // namespace cleave

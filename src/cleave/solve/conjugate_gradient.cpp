@@ -1,0 +1,74 @@
+#include "cleave/solve/conjugate_gradient.hpp"
+
+#include <cmath>
+
+#include "cleave/solve/sparse_multiply.hpp"
+
+namespace cleave {
+namespace {
+
+/// Restarts from the true residual when the recurrence claims convergence but the true residual
+/// (rounding drift) does not; more than a couple never help.
+constexpr int kMaxRestarts = 2;
+
+enum class CgStop { converged_recurrence, out_of_iterations, breakdown };
+
+/// Plain PCG from x; `iterations` is increased by the iterations done.
+CgStop run_pcg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double target,
+               int max_iterations, int& iterations) {
+  const Eigen::Index n = a.rows();
+  Vector r(n), z(n), p(n), q(n);
+  residual(a, b, x, r);
+  if (r.norm() <= target) return CgStop::converged_recurrence;
+  preconditioner.apply(r, z);
+  p = z;
+  double rz = r.dot(z);
+  while (iterations < max_iterations) {
+    multiply(a, p, q);
+    const double curvature = p.dot(q);
+    if (!(curvature > 0) || !(rz > 0) || !std::isfinite(curvature) || !std::isfinite(rz)) return CgStop::breakdown;
+    const double alpha = rz / curvature;
+    x.noalias() += alpha * p;
+    r.noalias() -= alpha * q;
+    ++iterations;
+    const double r_norm = r.norm();
+    if (!std::isfinite(r_norm)) return CgStop::breakdown;
+    if (r_norm <= target) return CgStop::converged_recurrence;
+    preconditioner.apply(r, z);
+    const double rz_next = r.dot(z);
+    p = z + (rz_next / rz) * p;
+    rz = rz_next;
+  }
+  return CgStop::out_of_iterations;
+}
+
+}  // namespace
+
+SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings) {
+  SolveReport report;
+  const Eigen::Index n = a.rows();
+  if (x.size() != n || !x.allFinite()) x = Vector::Zero(n);
+  const double b_norm = b.norm();
+  if (!(b_norm > 0)) {  // zero (or non-finite) load
+    x.setZero();
+    report.converged = std::isfinite(b_norm);
+    return report;
+  }
+  const double target = settings.relative_tolerance * b_norm;
+  const Vector start = x;
+  Vector r(n);
+  double r_norm = 0;
+  for (int restart = 0; restart <= kMaxRestarts; ++restart) {
+    const CgStop stop = run_pcg(a, b, x, preconditioner, target, settings.max_iterations, report.iterations);
+    if (!x.allFinite()) x = start;
+    residual(a, b, x, r);
+    r_norm = r.norm();
+    if (stop != CgStop::converged_recurrence || r_norm <= target) break;
+  }
+  report.relative_residual = r_norm / b_norm;
+  report.converged = report.relative_residual <= settings.relative_tolerance;
+  return report;
+}
+
+}  // namespace cleave

@@ -1,0 +1,36 @@
+#pragma once
+// Preconditioned conjugate gradients on a symmetric positive definite sparse matrix, with a
+// preconditioner behind a small interface so that block Jacobi and the multigrid V-cycle plug in.
+//
+//   SolveReport r = preconditioned_cg(a, b, x, preconditioner, settings);
+//
+// Inputs:  a  n x n SPD, compressed RowMajor (fixed dofs as identity rows, see linear_solver.hpp)
+//          b  n right-hand side;  x  n initial guess (warm start), overwritten by the solution
+//          preconditioner  z = M^-1 r with M symmetric positive definite
+// Output:  iterations done, relative residual ||b - A x|| / ||b|| reached (the true residual,
+//          recomputed at the end), converged when it is <= settings.relative_tolerance.
+// Edge cases: b = 0 gives x = 0 and converged after 0 iterations. A non-finite x on entry is
+// replaced by 0. When the iteration breaks down (non-positive curvature, NaN) or runs out of
+// iterations, x keeps its last finite value (at worst the initial guess) and converged = false:
+// x never holds NaN. Restarts from the true residual when rounding drift fools the recurrence.
+#include "cleave/solve/linear_solver.hpp"
+
+namespace cleave {
+
+class Preconditioner {
+ public:
+  virtual ~Preconditioner() = default;
+  /// z = M^-1 r (z is resized to r's size).
+  virtual void apply(const Vector& r, Vector& z) const = 0;
+};
+
+/// M = identity.
+class IdentityPreconditioner final : public Preconditioner {
+ public:
+  void apply(const Vector& r, Vector& z) const override { z = r; }
+};
+
+SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings);
+
+}  // namespace cleave

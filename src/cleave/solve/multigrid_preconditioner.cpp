@@ -1,0 +1,138 @@
+#include "cleave/solve/multigrid_preconditioner.hpp"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <Eigen/SparseCholesky>
+
+#include "cleave/core/error.hpp"
+#include "cleave/solve/galerkin_operator.hpp"
+#include "cleave/solve/grid_level.hpp"
+#include "cleave/solve/sparse_multiply.hpp"
+
+namespace cleave {
+namespace {
+
+constexpr std::size_t kVerticesPerTask = 1024;
+/// Diagonal shift (relative to the mean diagonal) tried when the coarsest factorization fails.
+constexpr double kCoarsestShift = 1e-10;
+
+}  // namespace
+
+struct MultigridPreconditioner::CoarsestSolver {
+  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
+};
+
+MultigridPreconditioner::MultigridPreconditioner() = default;
+MultigridPreconditioner::~MultigridPreconditioner() = default;
+MultigridPreconditioner::MultigridPreconditioner(MultigridPreconditioner&&) noexcept = default;
+MultigridPreconditioner& MultigridPreconditioner::operator=(MultigridPreconditioner&&) noexcept = default;
+
+void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine) {
+  const auto vertices = static_cast<std::size_t>(p.fine_count());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t v = range.begin(); v < range.end(); ++v) {
+      Vec3 sum = Vec3::Zero();
+      for (int e = p.fine_start[v]; e < p.fine_start[v + 1]; ++e) {
+        const auto& entry = p.by_fine[static_cast<std::size_t>(e)];
+        sum += entry.weight * coarse.segment<3>(3 * static_cast<Eigen::Index>(entry.vertex));
+      }
+      for (int axis = 0; axis < 3; ++axis)
+        if (!fine_fixed[3 * v + static_cast<std::size_t>(axis)]) fine[static_cast<Eigen::Index>(3 * v) + axis] += sum[axis];
+    }
+  });
+}
+
+void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& fine, Vector& coarse) {
+  const auto vertices = static_cast<std::size_t>(p.coarse_count());
+  coarse.resize(static_cast<Eigen::Index>(3 * vertices));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t v = range.begin(); v < range.end(); ++v) {
+      Vec3 sum = Vec3::Zero();
+      for (int e = p.coarse_start[v]; e < p.coarse_start[v + 1]; ++e) {
+        const auto& entry = p.by_coarse[static_cast<std::size_t>(e)];
+        const auto f = static_cast<std::size_t>(entry.vertex);
+        for (int axis = 0; axis < 3; ++axis)
+          if (!fine_fixed[3 * f + static_cast<std::size_t>(axis)]) sum[axis] += entry.weight * fine[static_cast<Eigen::Index>(3 * f) + axis];
+      }
+      coarse.segment<3>(static_cast<Eigen::Index>(3 * v)) = sum;
+    }
+  });
+}
+
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options) {
+  const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
+  if (a.rows() != dofs || a.cols() != dofs)
+    throw InputError(fmt::format("multigrid: matrix is {} x {}; expected {} x {} (3 dofs per vertex of the linked volume)",
+                                 a.rows(), a.cols(), dofs, dofs));
+  if (!a.isCompressed()) throw InputError("multigrid: matrix must be compressed (makeCompressed)");
+  MultigridPreconditioner m;
+  m.fine_ = &a;
+  GridLevel grid = grid_level_of(volume);
+  {
+    MultigridLevel fine;
+    fine.fixed = identity_rows(a);
+    m.levels_.push_back(std::move(fine));
+  }
+  while (static_cast<int>(m.levels_.size()) < options.max_levels) {
+    const std::size_t l = m.levels_.size() - 1;
+    const SparseMatrix& current = m.operator_of(l);
+    if (current.rows() <= options.coarsest_max_dofs) break;
+    Coarsening next = coarsen_grid_level(grid);
+    const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
+    if (ratio > options.min_coarsening_ratio) break;
+    MultigridLevel coarse;
+    coarse.matrix = galerkin_operator(current, m.levels_[l].fixed, next.prolongation);
+    coarse.fixed = identity_rows(coarse.matrix);
+    m.levels_[l].from_coarser = std::move(next.prolongation);
+    grid = std::move(next.coarse);
+    m.levels_.push_back(std::move(coarse));
+  }
+  for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l)
+    m.levels_[l].smoother = make_chebyshev_smoother(m.operator_of(l), options.smoother);
+
+  m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
+  const Eigen::SparseMatrix<double> coarsest(m.operator_of(m.levels_.size() - 1));
+  m.coarsest_->ldlt.compute(coarsest);
+  if (m.coarsest_->ldlt.info() != Eigen::Success) {
+    const double shift = kCoarsestShift * coarsest.diagonal().cwiseAbs().mean();
+    Eigen::SparseMatrix<double> identity(coarsest.rows(), coarsest.cols());
+    identity.setIdentity();
+    m.coarsest_->ldlt.compute(coarsest + shift * identity);
+    if (m.coarsest_->ldlt.info() != Eigen::Success)
+      throw ComputeError(fmt::format("multigrid: the coarsest level ({} dofs) cannot be factored", coarsest.rows()));
+  }
+  for (auto& level : m.levels_) {
+    const Eigen::Index n = level.fixed.size() == 0 ? 0 : static_cast<Eigen::Index>(level.fixed.size());
+    level.rhs.setZero(n);
+    level.solution.setZero(n);
+    level.residual.setZero(n);
+  }
+  return m;
+}
+
+void MultigridPreconditioner::cycle(std::size_t l) const {
+  const MultigridLevel& level = levels_[l];
+  const SparseMatrix& a = operator_of(l);
+  if (l + 1 == levels_.size()) {
+    level.solution = coarsest_->ldlt.solve(level.rhs);
+    if (!level.solution.allFinite()) level.solution.setZero();
+    return;
+  }
+  level.smoother.smooth_from_zero(a, level.rhs, level.solution, level.work);
+  residual(a, level.rhs, level.solution, level.residual);
+  const MultigridLevel& coarse = levels_[l + 1];
+  restrict_to_coarse(level.from_coarser, level.fixed, level.residual, coarse.rhs);
+  cycle(l + 1);
+  prolongate_add(level.from_coarser, level.fixed, coarse.solution, level.solution);
+  level.smoother.smooth(a, level.rhs, level.solution, level.work);
+}
+
+void MultigridPreconditioner::apply(const Vector& r, Vector& z) const {
+  levels_[0].rhs = r;
+  cycle(0);
+  z = levels_[0].solution;
+}
+
+}  // namespace cleave

@@ -1,0 +1,74 @@
+#pragma once
+// The cut-aware geometric multigrid V-cycle used as CG preconditioner (paper section 6.4 after
+// Dick, Georgii & Westermann 2011). Levels come from the linked volume by repeated 2x2x2
+// coarsening with cell replication (coarsen_grid_level.hpp), so pieces separated by cuts stay
+// separated on every level; coarse operators are Galerkin products P^T A P with fixed dofs left
+// out of P (galerkin_operator.hpp); Chebyshev / block-Jacobi smoothing before and after the
+// coarse correction (chebyshev_smoother.hpp); a sparse Cholesky (LDL^T) solve on the coarsest level.
+//
+//   MultigridPreconditioner m = build_multigrid(a, volume);   // a: 3 n_v x 3 n_v on volume's vertices
+//   m.apply(r, z);                                            // z = one V-cycle on A z = r from z = 0
+//
+// Inputs: a compressed RowMajor, symmetric positive definite (fixed dofs as identity rows), rows
+// 3 v + axis for the volume's current vertices; `a` is referenced, not copied, and must outlive
+// the preconditioner. Throws InputError when the sizes do not match.
+// apply() uses internal work vectors: one apply at a time per object.
+#include <memory>
+#include <vector>
+
+#include "cleave/solve/chebyshev_smoother.hpp"
+#include "cleave/solve/coarsen_grid_level.hpp"
+#include "cleave/solve/conjugate_gradient.hpp"
+
+namespace cleave {
+
+struct MultigridOptions {
+  int coarsest_max_dofs = 2000;          ///< stop coarsening once a level is this small
+  double min_coarsening_ratio = 0.85;    ///< stop when a level keeps more than this share of dofs
+  int max_levels = 12;
+  ChebyshevOptions smoother;
+};
+
+/// One level: its operator, smoother, and the prolongation from the next coarser level.
+struct MultigridLevel {
+  SparseMatrix matrix;              ///< coarse levels only; level 0 uses the referenced fine matrix
+  std::vector<std::uint8_t> fixed;  ///< per dof: identity row
+  ChebyshevSmoother smoother;
+  Prolongation from_coarser;        ///< empty on the coarsest level
+  mutable Vector rhs, solution, residual;
+  mutable ChebyshevWork work;
+};
+
+class MultigridPreconditioner final : public Preconditioner {
+ public:
+  MultigridPreconditioner();
+  ~MultigridPreconditioner() override;
+  MultigridPreconditioner(MultigridPreconditioner&&) noexcept;
+  MultigridPreconditioner& operator=(MultigridPreconditioner&&) noexcept;
+
+  void apply(const Vector& r, Vector& z) const override;
+
+  /// Level 0 is the fine level; the last level is solved directly.
+  const std::vector<MultigridLevel>& levels() const { return levels_; }
+  /// The operator of a level (level 0: the referenced fine matrix).
+  const SparseMatrix& operator_of(std::size_t level) const { return level == 0 ? *fine_ : levels_[level].matrix; }
+
+ private:
+  friend MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume,
+                                                 const MultigridOptions& options);
+  struct CoarsestSolver;
+  void cycle(std::size_t level) const;
+
+  const SparseMatrix* fine_ = nullptr;
+  std::vector<MultigridLevel> levels_;
+  std::unique_ptr<CoarsestSolver> coarsest_;
+};
+
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {});
+
+/// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
+void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
+/// coarse = P^T fine, leaving fixed fine dofs out.
+void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& fine, Vector& coarse);
+
+}  // namespace cleave

@@ -1,0 +1,92 @@
+// Solver timings on the paper's 44,000-cell tube (Table 1), static and one implicit Newmark step.
+// A benchmark, not a test: DISABLED_ so that it runs only on request:
+//   cleave_test_solve --gtest_also_run_disabled_tests --gtest_filter='*Benchmark*'
+// It prints setup and solve times and iterations per solver and checks that the solvers agree.
+#include <gtest/gtest.h>
+
+#include <chrono>
+
+#include "cleave/fem/lumped_mass.hpp"
+#include "cleave/shapes/builtin_shapes.hpp"
+#include "solve_test_systems.hpp"
+
+namespace cleave {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+double ms_since(Clock::time_point t) { return std::chrono::duration<double, std::milli>(Clock::now() - t).count(); }
+
+constexpr double kTimeStep_s = 1.0 / 60.0;
+constexpr double kNewmarkMassFactor = 4.0 / (kTimeStep_s * kTimeStep_s);  // beta = 1/4
+constexpr double kLoad_mN = 1e-3;
+
+struct Systems {
+  TissueModel model;
+  test::LinearSystem statics, dynamics;
+};
+
+Systems tube_44k() {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(42, 42, 51);
+  Material m;
+  m.youngs_modulus_kPa = test::kTissueE_kPa;
+  m.poisson_ratio = test::kTissueNu;
+  Systems s{make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}}), {}, {}};
+  const LinkedVolume& volume = s.model.volume;
+  const SparseMatrix k = assemble_stiffness(s.model);
+  const Vector mass = lumped_mass(s.model);
+  std::vector<VertexId> held;
+  Vector f = Vector::Zero(3 * volume.vertex_count());
+  const double z0 = volume.grid().origin_mm.z();
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    if (volume.vertex_position_mm(v).z() < z0 + 1e-9) held.push_back(v);
+    f[3 * v] = kLoad_mN;
+  }
+  const FixedDofs fixed = fix_vertices(volume.vertex_count(), held);
+  s.statics = {k, f};
+  eliminate_fixed_dofs(s.statics.a, s.statics.b, fixed);
+  SparseMatrix dynamic = k;
+  for (Eigen::Index i = 0; i < dynamic.rows(); ++i) dynamic.coeffRef(i, i) += kNewmarkMassFactor * mass[i];
+  s.dynamics = {dynamic, f};
+  eliminate_fixed_dofs(s.dynamics.a, s.dynamics.b, fixed);
+  s.statics.a.makeCompressed();
+  s.dynamics.a.makeCompressed();
+  return s;
+}
+
+void run(const char* what, const test::LinearSystem& s, const LinkedVolume& volume) {
+  SolveSettings settings;
+  settings.relative_tolerance = 1e-8;
+  Vector reference;
+  for (const SolverKind kind : {SolverKind::multigrid_cg, SolverKind::eigen_cg, SolverKind::cholmod}) {
+    auto solver = make_linear_solver(kind, settings);
+    auto t = Clock::now();
+    solver->setup(s.a, volume);
+    const double setup_ms = ms_since(t);
+    Vector x = Vector::Zero(s.b.size());
+    t = Clock::now();
+    const SolveReport cold = solver->solve(s.b, x);
+    const double cold_ms = ms_since(t);
+    const Vector b2 = 1.01 * s.b;  // the next step's load: a warm start from this solution
+    t = Clock::now();
+    const SolveReport warm = solver->solve(b2, x);
+    const double warm_ms = ms_since(t);
+    std::printf("%s %-9s setup %8.1f ms | cold solve %8.1f ms %4d it | warm solve %8.1f ms %4d it | residual %.1e\n", what,
+                std::string(solver->name()).c_str(), setup_ms, cold_ms, cold.iterations, warm_ms, warm.iterations,
+                warm.relative_residual);
+    EXPECT_TRUE(cold.converged && warm.converged) << solver->name();
+    if (reference.size() == 0) reference = x;
+    EXPECT_LT((x - reference).norm() / reference.norm(), 1e-6) << solver->name();
+  }
+}
+
+TEST(SolverBenchmark, DISABLED_Tube44kStaticAndNewmarkStep) {
+  const Systems s = tube_44k();
+  std::printf("tube 42x42x51: %d cells, %d vertices, %lld nonzeros\n", s.model.volume.cell_count(), s.model.volume.vertex_count(),
+              static_cast<long long>(s.statics.a.nonZeros()));
+  run("static ", s.statics, s.model.volume);
+  run("newmark", s.dynamics, s.model.volume);
+}
+
+}  // namespace
+}  // namespace cleave
