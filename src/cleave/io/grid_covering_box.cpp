@@ -36,7 +36,8 @@ GridSpec grid_covering_box(const Vec3& lo_mm, const Vec3& hi_mm, double cell_siz
   const double bytes = voxels * kLabelVolumeBytesPerVoxel;
   const std::string grid_words = fmt::format("{} (a {:.0f}x{:.0f}x{:.0f} grid)", what, cells.x(), cells.y(), cells.z());
   if (cells.maxCoeff() > kMaxCellsPerAxis || bytes >= static_cast<double>(std::numeric_limits<std::uint64_t>::max()))
-    require_memory(std::numeric_limits<std::uint64_t>::max(), grid_words);
+    throw InputError(fmt::format("{} would need {:.3g} GiB of memory; choose a larger cell size or a smaller region",
+                                 grid_words, bytes / static_cast<double>(std::uint64_t{1} << 30)));
   require_memory(static_cast<std::uint64_t>(bytes), grid_words);
 
   GridSpec grid;

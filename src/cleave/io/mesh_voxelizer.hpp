@@ -26,8 +26,9 @@ inline constexpr int kDefaultMeshCellsAlongLargestExtent = 64;
 /// corner (mm, negative inside, clamped to +-1.5 cells away from the surface). The grid covers
 /// the mesh's bounding box plus one empty cell on every side.
 /// Throws InputError naming options.source: empty mesh, non-positive cell size, a grid that would
-/// not fit in memory (before voxelizing), or a surface that encloses no cell (open, flat or
-/// degenerate: "encloses no volume").
+/// not fit in memory (before voxelizing), or a surface that encloses nothing: no cell centre half
+/// a cell deep inside, or an inside region whose boundary mostly lies away from the triangles
+/// (open, flat or degenerate surfaces: "encloses no volume").
 LabelVolume voxelize_surface_mesh(const SurfaceMesh& mesh, const MeshVoxelizeOptions& options);
 
 }  // namespace cleave

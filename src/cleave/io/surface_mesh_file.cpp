@@ -8,6 +8,7 @@
 #include <limits>
 
 #include "cleave/core/error.hpp"
+#include "cleave/io/off_mesh_file.hpp"
 
 namespace cleave {
 
@@ -18,12 +19,26 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw InputError(fmt::format("{}: no such file", f));
 
+  std::string extension = file.extension().string();
+  for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
+  if (extension == ".off") {
+    SurfaceMesh mesh = read_off_mesh(file, scale);
+    if (mesh.triangles.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", f));
+    for (const Vec3& p : mesh.vertices_mm)
+      if (!p.allFinite())
+        throw InputError(fmt::format("{}: mesh scale {} makes coordinates overflow; expected a smaller scale", f, scale));
+    return mesh;
+  }
+
   Assimp::Importer importer;
   // Keep points and lines out (only triangles bound a volume); no normals or UVs are needed.
+  // Per-face normals (STL) and other attributes would keep identical positions apart when joining.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
+  importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
+                                                          aiComponent_COLORS | aiComponent_TEXCOORDS);
   const aiScene* scene =
-      importer.ReadFile(f, aiProcess_Triangulate | aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
-                               aiProcess_SortByPType);
+      importer.ReadFile(f, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
+                               aiProcess_PreTransformVertices | aiProcess_SortByPType);
   if (scene == nullptr) {
     std::string why = importer.GetErrorString();
     while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();

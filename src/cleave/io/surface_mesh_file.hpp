@@ -1,6 +1,6 @@
 #pragma once
-// Reading a triangle surface mesh from OBJ, STL (ASCII or binary), PLY (ASCII or binary) or OFF
-// with assimp, as plain arrays.
+// Reading a triangle surface mesh from OBJ, STL (ASCII or binary), PLY (ASCII or binary) with
+// assimp, or OFF with cleave's own parser (off_mesh_file.hpp; assimp aborts on truncated OFF).
 #include <array>
 #include <filesystem>
 #include <vector>
