@@ -45,7 +45,7 @@ NrrdPtr load(const std::filesystem::path& file, bool header_only) {
   std::unique_ptr<NrrdIoState, NrrdIoDeleter> nio(nrrdIoStateNew());
   nio->skipData = header_only ? AIR_TRUE : AIR_FALSE;
   if (nrrdLoad(nrrd.get(), file.string().c_str(), nio.get()) != 0)
-    throw InputError(fmt::format("{}: {}", file.string(), take_teem_error(NRRD)));
+    throw InputError(fmt::format("{}: cannot read NRRD: {}", file.string(), take_teem_error(NRRD)));
   return nrrd;
 }
 
