@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <fmt/format.h>
+#include <functional>
 
 #include "cleave/core/error.hpp"
 #include "cleave/surface/corner_fans.hpp"
