@@ -5,6 +5,7 @@
 //   and the invariants: cutting nothing changes nothing; two free pieces stay finite and in place.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <span>
@@ -188,13 +189,17 @@ TEST(ReleasePhysics, TwoFreePiecesStayFiniteAndInPlace) {
 
 
 TEST(ReleasePhysics, Section7AbdomenFiveCentimetreCutAcrossTheLinesOpensFiveToTwentyMm) {
-  // The built-in abdominal wall (5 mm cells, 10.8 mm thick), E = 80 kPa, nu = 0.4; Langer's lines
+  // The built-in abdominal wall (10.8 mm thick), E = 80 kPa, nu = 0.4; Langer's lines
   // run horizontally around the body (x projected into the tangent plane) with 20 kPa, 10 kPa
-  // across; the wall's rim is held. A 5 cm cut across the lines, 8 mm deep, on the dome's flank.
+  // across; the wall's rim is held. A 5 cm cut across the lines through the wall (10 mm), on the dome's flank.
   Material m;
   m.youngs_modulus_kPa = kYoungKPa;
   m.poisson_ratio = kPoisson;
-  TissueModel model = make_tissue_model("abdomen", make_builtin_shape("abdomen"), {{1, m}, {2, m}, {3, m}});
+  // 2.5 mm cells (4 through the wall): at the default 5 mm the two-cell-thick wall is too stiff in
+  // shear and the opening is underestimated (4.98 mm measured there).
+  ShapeResolution res;
+  res.cell_size_mm = 2.5;
+  TissueModel model = make_tissue_model("abdomen", make_builtin_shape("abdomen", res), {{1, m}, {2, m}, {3, m}});
   const BodySurface surface(model);
   std::vector<Vec6> stress;
   for (CellId c = 0; c < model.volume.cell_count(); ++c) {
@@ -209,20 +214,34 @@ TEST(ReleasePhysics, Section7AbdomenFiveCentimetreCutAcrossTheLinesOpensFiveToTw
     const Vec3 p = model.volume.vertex_position_mm(v);
     if (p.x() <= kRimMm || p.z() <= kRimMm || p.x() >= extent.x() - kRimMm || p.z() >= extent.z() - kRimMm) rim.push_back(v);
   }
+  // The wall lies on the body beneath: the free faces of the innermost layer (muscle, label 3)
+  // are held, so that the tangential tension cannot relax by the dome sagging before the cut.
+  constexpr Label kMuscle = 3;
+  for (CellId c = 0; c < model.volume.cell_count(); ++c)
+    if (model.volume.cell_label(c) == kMuscle)
+      for (Face f = 0; f < kFaceCount; ++f)
+        if (model.volume.neighbor(c, f) == kNone)
+          for (const int k : face_corners(f)) rim.push_back(model.volume.corner_vertex(c, k));
+  std::sort(rim.begin(), rim.end());
+  rim.erase(std::unique(rim.begin(), rim.end()), rim.end());
   const auto skin = [&](double x, double z) {
     double y = extent.y();
     while (y > 0 && !surface.inside(Vec3(x, y, z))) y -= 0.25;
     return Vec3(x, y, z);
   };
+  constexpr double kCutDepthMm = 10.0;
   const double x = 0.32 * extent.x(), zc = 0.5 * extent.z();
   CutRequests r;
-  r.scalpel_cuts.push_back({{skin(x, zc - 25), skin(x, zc + 25)}, 8.0, 0.0});
+  r.scalpel_cuts.push_back({{skin(x, zc - 25), skin(x, zc + 25)}, kCutDepthMm, 0.0});
   const CutPlan plan = plan_cuts(surface, r);
   EXPECT_NEAR(plan.scalpel_paths[0].length_mm, 50.0, 2.5);
   apply_cut_plan(model.volume, plan);
   const StaticResult s = solve_static(model, stress, held(model.volume, rim));
   const WoundWidth w = scalpel_wound_width(model.volume, s.displacement_mm, plan.scalpel_paths[0]);
-  std::printf("section7: 5 cm cut across the lines opens %.3f mm at most, %.3f mm on average\n", w.max_mm, w.mean_mm);
+  double max_u = 0;
+  for (const Vec3& u : s.displacement_mm) max_u = std::max(max_u, u.norm());
+  std::printf("section7: 5 cm cut across the lines opens %.3f mm at most, %.3f mm on average (%zu links cut, %d samples, max |u| %.3f mm, skin y %.2f)\n",
+              w.max_mm, w.mean_mm, plan.steps[0].links.size(), w.samples, max_u, plan.scalpel_paths[0].skin_mm[10].y());
   RecordProperty("max_width_mm", std::to_string(w.max_mm));
   EXPECT_GE(w.max_mm, 5.0);
   EXPECT_LE(w.max_mm, 20.0);
