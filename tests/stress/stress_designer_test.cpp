@@ -1,0 +1,69 @@
+// Incremental edits give the same field as a fresh design; failing edits change nothing.
+#include <gtest/gtest.h>
+
+#include <fmt/format.h>
+#include <limits>
+
+#include "cleave/core/error.hpp"
+
+#include "cleave/stress/stress_designer.hpp"
+#include "stress_test_models.hpp"
+
+namespace cleave {
+namespace {
+
+double relative_difference(const DesignResult& a, const DesignResult& b) {
+  double diff = 0, size = 0;
+  for (std::size_t c = 0; c < a.stress_kPa.size(); ++c) {
+    diff = std::max(diff, (a.stress_kPa[c] - b.stress_kPa[c]).cwiseAbs().maxCoeff());
+    size = std::max(size, b.stress_kPa[c].cwiseAbs().maxCoeff());
+  }
+  return diff / size;
+}
+
+class DesignerEdits : public ::testing::TestWithParam<EigenvalueSolver> {};
+
+TEST_P(DesignerEdits, EditsEqualAFreshDesign) {
+  const TissueModel m = test::builtin_model("plate", {Vec3i(16, 16, 2), std::nullopt});
+  StressDesign d;
+  d.solver = GetParam();
+  d.equilibration = Equilibration::none;
+  d.strokes = {DesignStroke{{{10, 50, 10}, {90, 50, 10}}, StrokePlacement::surface}};
+  d.control_points = {{{20, 20, 10}, 20, 10}};
+  StressDesigner designer(m, d);
+  designer.add_stroke(DesignStroke{{{50, 10, 10}, {50, 90, 10}}, StrokePlacement::surface});
+  designer.move_stroke(0, DesignStroke{{{10, 30, 10}, {90, 70, 10}}, StrokePlacement::surface});
+  designer.add_control_point({{80, 80, 10}, 30, 5});
+  designer.move_control_point(0, {{30, 20, 10}, 25, 12});
+  designer.add_stroke(DesignStroke{{{10, 10, 10}, {90, 90, 10}}, StrokePlacement::surface});
+  designer.delete_stroke(2);
+  designer.add_control_point({{50, 50, 0}, 5, 5});
+  designer.delete_control_point(2);
+
+  StressDesign final_design = d;
+  final_design.strokes = {DesignStroke{{{10, 30, 10}, {90, 70, 10}}, StrokePlacement::surface},
+                          DesignStroke{{{50, 10, 10}, {50, 90, 10}}, StrokePlacement::surface}};
+  final_design.control_points = {{{30, 20, 10}, 25, 12}, {{80, 80, 10}, 30, 5}};
+  const DesignResult fresh = design_residual_stress(m, final_design);
+  EXPECT_LT(relative_difference(designer.result(), fresh), 1e-8);
+}
+
+INSTANTIATE_TEST_SUITE_P(Solvers, DesignerEdits, ::testing::Values(EigenvalueSolver::cholesky, EigenvalueSolver::paper_cg));
+
+TEST(Designer, AFailingEditLeavesTheDesignAsItWas) {
+  const TissueModel m = test::builtin_model("plate", {Vec3i(16, 16, 2), std::nullopt});
+  StressDesign d;
+  d.strokes = {DesignStroke{{{10, 50, 10}, {90, 50, 10}}, StrokePlacement::surface}};
+  d.control_points = {{{20, 20, 10}, 20, 10}};
+  StressDesigner designer(m, d);
+  const std::vector<Vec6> before = designer.result().stress_kPa;
+  EXPECT_THROW(designer.add_stroke(DesignStroke{{{10, 50, 10}}, StrokePlacement::surface}), InputError);
+  EXPECT_THROW(designer.delete_control_point(0), InputError);  // would leave no control point
+  EXPECT_THROW(designer.move_stroke(5, d.strokes[0]), InputError);
+  EXPECT_EQ(designer.design().strokes.size(), 1u);
+  EXPECT_EQ(designer.design().control_points.size(), 1u);
+  EXPECT_EQ(designer.result().stress_kPa, before);
+}
+
+}  // namespace
+}  // namespace cleave
