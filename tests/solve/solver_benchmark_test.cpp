@@ -74,6 +74,7 @@ void run(const char* what, const test::LinearSystem& s, const LinkedVolume& volu
     std::printf("%s %-9s setup %8.1f ms | cold solve %8.1f ms %4d it | warm solve %8.1f ms %4d it | residual %.1e\n", what,
                 std::string(solver->name()).c_str(), setup_ms, cold_ms, cold.iterations, warm_ms, warm.iterations,
                 warm.relative_residual);
+    std::fflush(stdout);
     EXPECT_TRUE(cold.converged && warm.converged) << solver->name();
     if (reference.size() == 0) reference = x;
     EXPECT_LT((x - reference).norm() / reference.norm(), 1e-6) << solver->name();
@@ -84,6 +85,7 @@ TEST(SolverBenchmark, DISABLED_Tube44kStaticAndNewmarkStep) {
   const Systems s = tube_44k();
   std::printf("tube 42x42x51: %d cells, %d vertices, %lld nonzeros\n", s.model.volume.cell_count(), s.model.volume.vertex_count(),
               static_cast<long long>(s.statics.a.nonZeros()));
+  std::fflush(stdout);
   run("static ", s.statics, s.model.volume);
   run("newmark", s.dynamics, s.model.volume);
 }
