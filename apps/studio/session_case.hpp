@@ -1,9 +1,9 @@
 #pragma once
 // The studio's design as case-file sections and back, so that a saved session runs with
 // `cleave run` and a case loads into the studio (docs/case-format.md):
-//   "design": {"strokes":[{"points_mm":[[x,y,z],...]}],
-//              "control_points":[{"position_mm":[x,y,z],"langer_kPa":20,"cross_kPa":10}]}
-//   "cuts":   [{"kind":"scalpel"|"flap","path_mm":[[x,y,z],...],"depth_mm":5}]
+//   "design": {"strokes":[{"points":[[x,y,z],...]}],             (io/case_design.hpp)
+//              "control_points":[{"position":[x,y,z],"langer_kPa":20,"cross_kPa":10}]}
+//   "cuts":   [{"type":"scalpel"|"flap","path_mm":[[x,y,z],...],"depth_mm":5}]   (io/case_cuts.hpp; flaps "shape":"u")
 // Ids are session-local and not saved; loading numbers the items from `first_id`.
 #include <nlohmann/json.hpp>
 #include <string>

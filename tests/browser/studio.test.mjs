@@ -190,6 +190,7 @@ test('save, reload the page, load: the same design comes back', async () => {
     const doc = JSON.parse(text);
     assert.equal(doc.model.source, 'abdomen');
     assert.equal(doc.design.strokes.length, 1);
+    assert.ok(Array.isArray(doc.design.strokes[0].points), "case_design format: strokes[].points");
   });
 });
 

@@ -6,6 +6,7 @@
 #include <unistd.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/io/atomic_file.hpp"
 #include "studio/session_journal.hpp"
 
 namespace cleave::studio {
@@ -18,10 +19,7 @@ std::filesystem::path fresh_folder(const std::string& name) {
   return dir;
 }
 
-std::string read_all(const std::filesystem::path& f) {
-  std::ifstream in(f, std::ios::binary);
-  return {std::istreambuf_iterator<char>(in), {}};
-}
+std::string read_all(const std::filesystem::path& f) { return read_file(f); }
 
 TEST(SessionJournal, AppendsAreNumberedAndReplayedInOrder) {
   const auto file = fresh_folder("append") / "journal.jsonl";

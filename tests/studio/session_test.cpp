@@ -9,6 +9,7 @@
 #include <unistd.h>
 
 #include "cleave/core/error.hpp"
+#include "studio/design_limits.hpp"
 #include "studio/field_worker.hpp"
 #include "studio/message_handler.hpp"
 #include "studio/studio_session.hpp"
@@ -61,9 +62,9 @@ TEST(StudioSession, RestartReplaysTheJournalToTheSameState) {
     s.apply_edit(stroke(1));
     s.apply_edit({{"cmd", "add_control_point"}, {"position_mm", {4, 4, 1}}, {"langer_kPa", 25}});
     s.apply_edit({{"cmd", "set_control_point"}, {"id", 2}, {"cross_kPa", 7.5}});
+    s.apply_edit({{"cmd", "add_cut"}, {"kind", "flap"}, {"path_mm", {{1, 1, 1}, {6, 1, 1}, {6, 6, 1}}}, {"depth_mm", 2}});
     s.apply_edit(stroke(2));
     s.apply_edit({{"cmd", "undo"}});
-    s.apply_edit({{"cmd", "add_cut"}, {"kind", "flap"}, {"path_mm", {{1, 1, 1}, {6, 1, 1}, {6, 6, 1}}}, {"depth_mm", 2}});
     before = s.design();
     seq = s.seq();
   }
@@ -120,7 +121,7 @@ TEST(MessageHandler, ErrorsAreOneLineAndLeaveTheSessionUnchanged) {
             "message: /points_mm is 1; expected an array of 2 to 4096 points [x, y, z] in mm");
   EXPECT_EQ(error_of(R"({"cmd":"delete_stroke","id":99})"), "message: no stroke with id 99");
   EXPECT_EQ(error_of(R"({"cmd":"add_control_point","position_mm":[0,0,0],"langer_kPa":1e9})"),
-            "message: /langer_kPa is 1000000000; expected an eigenvalue in kPa");
+            "message: /langer_kPa is 1000000000.0; expected an eigenvalue in kPa");
   EXPECT_EQ(error_of(R"({"cmd":"add_cut","path_mm":[[0,0,0],[1,0,0]],"depth_mm":-1})"),
             "message: /depth_mm is -1; expected a depth in mm");
   EXPECT_EQ(error_of(R"([1,2])"), "message: expected a JSON object {\"cmd\": ...}");
