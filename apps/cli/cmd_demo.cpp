@@ -90,7 +90,7 @@ json demo_case(const TissueModel& model, bool with_design) {
                      {"fixed", json::array({box(-1, -1, -1, kRimMm, top, l + 1), box(w - kRimMm, -1, -1, w + 1, top, l + 1),
                                             box(-1, -1, -1, w + 1, top, kRimMm), box(-1, -1, l - kRimMm, w + 1, top, l + 1)})}};
   if (with_design)
-    c["design"] = {{"strokes", strokes}, {"control_points", controls}};
+    c["design"] = {{"strokes", strokes}, {"control_points", controls}, {"equilibrate", false}};
   else
     c["residual_stress"] = {{"uniform_kPa", json::array({kLangerKPa, 0.0, kCrossKPa, 0.0, 0.0, 0.0})}};
   return c;
