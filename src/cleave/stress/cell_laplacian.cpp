@@ -22,4 +22,14 @@ SparseMatrix cell_laplacian(const LinkedVolume& volume) {
   return l;
 }
 
+std::vector<bool> cells_of_unconstrained_pieces(const LinkedVolume& volume, const std::vector<CellId>& constrained_cells) {
+  const std::vector<int>& component = volume.cell_components();
+  std::vector<bool> piece_constrained(static_cast<std::size_t>(volume.component_count()), false);
+  for (CellId c : constrained_cells)
+    if (c >= 0 && c < volume.cell_count()) piece_constrained[static_cast<std::size_t>(component[static_cast<std::size_t>(c)])] = true;
+  std::vector<bool> out(static_cast<std::size_t>(volume.cell_count()));
+  for (std::size_t c = 0; c < out.size(); ++c) out[c] = !piece_constrained[static_cast<std::size_t>(component[c])];
+  return out;
+}
+
 }  // namespace cleave

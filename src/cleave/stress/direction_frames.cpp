@@ -62,7 +62,7 @@ std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_ten
   return frames;
 }
 
-double line_angle_deg(const Vec3& d, const Vec3& e) {
+double angle_between_lines_deg(const Vec3& d, const Vec3& e) {
   const double cosine = std::clamp(std::abs(d.normalized().dot(e.normalized())), 0.0, 1.0);
   return std::acos(cosine) * 180.0 / std::numbers::pi;
 }

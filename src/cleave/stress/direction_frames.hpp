@@ -29,6 +29,6 @@ std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_ten
 DirectionFrame direction_frame(const Mat3& langer_tensor, const Mat3& normal_tensor);
 
 /// |d . e| turned into an angle in degrees in [0, 90]: the angle between two lines.
-double line_angle_deg(const Vec3& d, const Vec3& e);
+double angle_between_lines_deg(const Vec3& d, const Vec3& e);
 
 }  // namespace cleave

@@ -13,7 +13,6 @@
 namespace cleave {
 namespace {
 
-constexpr double kGuard = 1e-10;               ///< Tikhonov guard relative to w_L (dimensionless)
 constexpr double kPaperCgTolerance = 1e-12;    ///< relative residual of the reference CG
 constexpr int kPaperCgMaxIterations = 200000;  ///< the plain CG needs many iterations on A^T A
 
@@ -62,8 +61,6 @@ EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const
     for (Eigen::SparseMatrix<double>::InnerIterator it(ltl, k); it; ++it)
       for (int i = 0; i < 3; ++i)
         entries.emplace_back(static_cast<int>(3 * it.row() + i), static_cast<int>(3 * it.col() + i), weights.laplacian * it.value());
-  for (Eigen::Index r = 0; r < 3 * ltl.rows(); ++r)
-    entries.emplace_back(static_cast<int>(r), static_cast<int>(r), kGuard * weights.laplacian);
   smoothness_.resize(3 * ltl.rows(), 3 * ltl.cols());
   smoothness_.setFromTriplets(entries.begin(), entries.end());
 }
@@ -88,13 +85,19 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
       rhs[3 * t.cell + i] += weights_.constraint * t.eigenvalues_kPa[i];
     }
   }
+  std::vector<CellId> constrained;
+  for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
+  const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
+  for (CellId c = 0; c < volume_.cell_count(); ++c)
+    if (pinned[static_cast<std::size_t>(c)])
+      for (int i = 0; i < 3; ++i) system.coeffRef(3 * c + i, 3 * c + i) += weights_.laplacian;  // no control point -> 0
   system.makeCompressed();
 
   EigenvalueSolution solution;
   Vector x;
   if (solver == EigenvalueSolver::cholesky) {
     cholesky_.factorize(system);
-    x = cholesky_.solve(rhs);
+    x = cholesky_.solve_refined(system, rhs);
   } else {
     x = Vector::Zero(n);
     if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)

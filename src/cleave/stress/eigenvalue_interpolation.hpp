@@ -1,7 +1,7 @@
 #pragma once
 // The eigenvalue fields (paper section 6.2): per cell lambda = (Langer, cross, normal) in kPa,
 //   min  w_L |L lambda|^2 + w_C |C lambda - lambda0|^2 + w_E |T (d sigma/d lambda) lambda / h^2|^2
-// (eq. 9; a 1e-10 w_L |lambda|^2 guard keeps it positive definite), solved on the normal equations
+// (eq. 9; pieces of the body without a control point get lambda = 0), solved on the normal equations
 // A^T A lambda = A^T b. The equilibrium rows are divided by h^2 (T is in mm^2) so that every term
 // is a stress in kPa. Free vertices are all vertices (the design is for the unsupported body).
 //
@@ -37,7 +37,7 @@ class EigenvalueInterpolator {
  private:
   const LinkedVolume& volume_;
   DesignWeights weights_;
-  Eigen::SparseMatrix<double> smoothness_;  ///< w_L (L^T L) (x) I3 + guard, ColMajor
+  Eigen::SparseMatrix<double> smoothness_;  ///< w_L (L^T L) (x) I3, ColMajor
   SparseCholesky cholesky_;
 };
 

@@ -8,18 +8,14 @@
 namespace cleave {
 namespace {
 
-/// Tikhonov guard relative to the Laplacian weight (dimensionless): keeps pieces without targets
-/// well posed (their field becomes 0) and moves constrained fields by ~1e-10 relative.
-constexpr double kGuard = 1e-10;
 
 }  // namespace
 
 LineFieldInterpolator::LineFieldInterpolator(const LinkedVolume& volume, const DesignWeights& weights)
-    : weights_(weights), cell_count_(volume.cell_count()) {
+    : volume_(volume), weights_(weights), cell_count_(volume.cell_count()) {
   const Eigen::SparseMatrix<double> l = cell_laplacian(volume);
   Eigen::SparseMatrix<double> ltl = Eigen::SparseMatrix<double>(l.transpose()) * l;
   smoothness_ = weights.laplacian * ltl;
-  for (CellId c = 0; c < cell_count_; ++c) smoothness_.coeffRef(c, c) += kGuard * weights.laplacian;
   smoothness_.makeCompressed();
 }
 
@@ -32,8 +28,13 @@ std::vector<Mat3> LineFieldInterpolator::interpolate(const std::vector<LineTarge
     system.coeffRef(t.cell, t.cell) += weights_.constraint;
     rhs.row(t.cell) += weights_.constraint * to_voigt(t.tensor).transpose();
   }
+  std::vector<CellId> constrained;
+  for (const LineTarget& t : targets) constrained.push_back(t.cell);
+  const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
+  for (CellId c = 0; c < cell_count_; ++c)
+    if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // piece without targets -> 0
   cholesky_.factorize(system);
-  const Eigen::MatrixXd x = cholesky_.solve(rhs);
+  const Eigen::MatrixXd x = cholesky_.solve_refined(system, rhs);
   std::vector<Mat3> field(static_cast<std::size_t>(cell_count_));
   for (CellId c = 0; c < cell_count_; ++c) field[static_cast<std::size_t>(c)] = from_voigt(x.row(c).transpose());
   return field;

@@ -2,8 +2,8 @@
 // Laplacian interpolation of a line field over the cells (paper eqs. 7 to 9 applied to
 // eigenvectors, issue 4 item 2): the unknown per cell is the symmetric tensor X (6 Voigt
 // components, each interpolated independently), found by
-//   min  w_L |L X|^2 + w_C sum over targets |X(cell) - target|^2  (+ a 1e-10 w_L |X|^2 guard)
-// so that cells of a body piece without any target get X = 0 instead of a singular system.
+//   min  w_L |L X|^2 + w_C sum over targets |X(cell) - target|^2
+// and X = 0 on body pieces (connected through uncut links) without any target.
 // Because a target is d d^T, the result is the same for d and -d: no cancellation between
 // strokes drawn in opposite directions.
 //
@@ -25,7 +25,8 @@ class LineFieldInterpolator {
   std::vector<Mat3> interpolate(const std::vector<LineTarget>& targets);
 
  private:
-  Eigen::SparseMatrix<double> smoothness_;  ///< w_L L^T L + guard, ColMajor
+  const LinkedVolume& volume_;
+  Eigen::SparseMatrix<double> smoothness_;  ///< w_L L^T L, ColMajor
   DesignWeights weights_;
   CellId cell_count_ = 0;
   SparseCholesky cholesky_;

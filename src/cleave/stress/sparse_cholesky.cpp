@@ -49,6 +49,15 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   }
 }
 
+Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const {
+  Eigen::MatrixXd x = solve(b);
+  for (int step = 0; step < kRefinementSteps; ++step) {
+    const Eigen::MatrixXd r = b - a * x;
+    x += solve(r);
+  }
+  return x;
+}
+
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   Eigen::MatrixXd x = impl_->llt.solve(b);
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())

@@ -23,6 +23,10 @@ class SparseCholesky {
 
   void factorize(const Eigen::SparseMatrix<double>& a);
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  /// Same, followed by kRefinementSteps of iterative refinement against `a` (the factorized
+  /// matrix): the design systems (L^T L, condition ~ n^2) lose digits in a plain solve.
+  Eigen::MatrixXd solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const;
+  static constexpr int kRefinementSteps = 2;
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 
