@@ -10,6 +10,7 @@
 //   preview      one incision-preview solve: statics of the body with round incisions cut
 //   step         one implicit corotational Newmark step during an ongoing cut
 //   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface
+#include <cstdint>
 #include <optional>
 #include <string>
 #include <string_view>
@@ -62,6 +63,7 @@ struct ModelFigures {
   int cells = 0;
   int vertices = 0;
   int incisions = 0;  ///< round incisions in the preview
+  std::int64_t stiffness_nonzeros = 0;  ///< stored entries of K of the incised body (bandwidth estimates)
   ImplementationFigures cleave;
   std::vector<ImplementationFigures> peers;
 };

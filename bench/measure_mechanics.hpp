@@ -12,6 +12,8 @@
 //
 // Each returns the stage's figures and its final displacement (3 n_v, mm) so peers can be
 // compared with cleave. ComputeError from a solver propagates.
+#include <cstdint>
+
 #include "bench_figures.hpp"
 #include "bench_scenario.hpp"
 #include "cleave/solve/linear_solver.hpp"
@@ -26,6 +28,7 @@ struct MechanicsOutcome {
   StageFigures figures;
   Eigen::VectorXd displacement_mm;  ///< final displacement, 3 n_v
   std::string solver;               ///< the solver's name
+  std::int64_t matrix_nonzeros = 0; ///< stored entries of the stiffness of the cut body
 };
 
 MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchScenario& scenario,

@@ -4,6 +4,7 @@
 
 #include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
+#include "measure_design.hpp"
 #include "measure_mechanics.hpp"
 #include "peak_memory.hpp"
 
@@ -15,6 +16,9 @@ struct ImplementationResults {
   ImplementationFigures figures;
   Eigen::VectorXd preview_mm;
   Eigen::VectorXd step_mm;
+  Eigen::VectorXd line_tensors;
+  Eigen::VectorXd eigenvalues_kPa;
+  std::int64_t stiffness_nonzeros = 0;
 };
 
 ImplementationResults run_implementation(const TissueModel& model, const BenchScenario& scenario,
@@ -24,20 +28,47 @@ ImplementationResults run_implementation(const TissueModel& model, const BenchSc
   r.figures.implementation = implementation;
   reset_peak_resident_memory();
   const std::string who(implementation_key(implementation));
-  report(progress, who + ": incision preview", done);
+  report(progress, who + ": design", done);
+  DesignOutcome design = measure_design(model, scenario, implementation, options.repeat);
+  r.figures.vector = design.vector;
+  r.figures.value = design.value;
+  r.figures.equilibrate = design.equilibrate;
+  r.figures.update = design.update;
+  r.line_tensors = std::move(design.line_tensors);
+  r.eigenvalues_kPa = std::move(design.eigenvalues_kPa);
+  report(progress, who + ": incision preview", done + 0.4 * share);
   MechanicsOutcome preview = measure_incision_preview(model, scenario, implementation, options.repeat);
-  report(progress, who + ": dynamic step", done + 0.5 * share);
+  report(progress, who + ": dynamic step", done + 0.7 * share);
   MechanicsOutcome step = measure_dynamic_step(model, scenario, implementation, options.repeat);
   r.figures.preview = preview.figures;
   r.figures.step = step.figures;
   r.figures.solver = preview.solver;
+  r.stiffness_nonzeros = preview.matrix_nonzeros;
   r.preview_mm = std::move(preview.displacement_mm);
   r.step_mm = std::move(step.displacement_mm);
   r.figures.peak_mb = peak_resident_memory_mb();
   return r;
 }
 
+/// A peer's edit-to-picture update: the sum of the medians of its own design and preview stages,
+/// with cleave's where the peer has none (the peers run no studio pipeline of their own).
+StageFigures composite_update(const ImplementationFigures& cleave, const ImplementationFigures& peer) {
+  StageFigures update;
+  double total_ms = 0;
+  for (Stage s : {Stage::vector, Stage::value, Stage::equilibrate, Stage::preview}) {
+    const StageFigures& own = peer.stage(s);
+    total_ms += (own.time.count > 0 ? own : cleave.stage(s)).time.median_ms;
+  }
+  const double samples[] = {total_ms};
+  update.time = summarize_timings(samples);
+  update.iterations = peer.preview.iterations;
+  return update;
+}
+
 void compare_with_cleave(const ImplementationResults& cleave, ImplementationResults& peer) {
+  if (peer.line_tensors.size() > 0) peer.figures.vector.relative_difference = relative_difference(peer.line_tensors, cleave.line_tensors);
+  if (peer.eigenvalues_kPa.size() > 0)
+    peer.figures.value.relative_difference = relative_difference(peer.eigenvalues_kPa, cleave.eigenvalues_kPa);
   peer.figures.preview.relative_difference = relative_difference(peer.preview_mm, cleave.preview_mm);
   peer.figures.step.relative_difference = relative_difference(peer.step_mm, cleave.step_mm);
 }
@@ -69,6 +100,7 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
   const ImplementationResults cleave =
       run_implementation(model, scenario, Implementation::cleave, options, progress, 0.0, share);
   figures.cleave = cleave.figures;
+  figures.stiffness_nonzeros = cleave.stiffness_nonzeros;
   for (std::size_t i = 0; i < options.peers.size(); ++i) {
     const Implementation peer = options.peers[i];
     if (figures.cells > options.peer_max_cells) {
@@ -77,6 +109,7 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
     }
     ImplementationResults r = run_implementation(model, scenario, peer, options, progress, share * static_cast<double>(i + 1), share);
     compare_with_cleave(cleave, r);
+    r.figures.update = composite_update(cleave.figures, r.figures);
     figures.peers.push_back(std::move(r.figures));
   }
   report(progress, fmt::format("{}: done", bench_model.key), 1.0);

@@ -1,0 +1,120 @@
+#include "measure_design.hpp"
+
+#include <algorithm>
+
+#include "cleave/cut/body_surface.hpp"
+#include "cleave/fem/assemble_stiffness.hpp"
+#include "cleave/fem/solve_static.hpp"
+#include "cleave/stress/stress_designer.hpp"
+#include "cleave/surface/render_surface.hpp"
+#include "implementation_setup.hpp"
+#include "paper_reference_directions.hpp"
+
+namespace cleave::bench {
+namespace {
+
+constexpr double kMsPerSecond = 1e3;
+
+DesignStroke stroke_of_edit(const BenchScenario& scenario, int edit) {
+  return edit % 2 == 0 ? scenario.edited_stroke : scenario.design.strokes.front();
+}
+
+Eigen::VectorXd flatten_eigenvalues(const std::vector<Vec3>& eigenvalues_kPa) {
+  Eigen::VectorXd out(3 * static_cast<Eigen::Index>(eigenvalues_kPa.size()));
+  for (std::size_t c = 0; c < eigenvalues_kPa.size(); ++c) out.segment<3>(3 * static_cast<Eigen::Index>(c)) = eigenvalues_kPa[c];
+  return out;
+}
+
+/// The incised body the preview shows, with what a stroke edit leaves unchanged.
+struct IncisedPreview {
+  TissueModel model;
+  SparseMatrix stiffness;
+  RenderSurface surface;
+};
+
+IncisedPreview incised_preview(const TissueModel& uncut, const BenchScenario& scenario) {
+  IncisedPreview p{uncut, {}, {}};
+  {
+    const BodySurface body(p.model);
+    apply_cut_plan(p.model.volume, plan_cuts(body, scenario.incisions));
+  }
+  p.stiffness = assemble_stiffness(p.model);
+  p.surface = build_render_surface(p.model);
+  return p;
+}
+
+DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scenario, int repeat) {
+  const IncisedPreview preview = incised_preview(uncut, scenario);
+  StressDesigner designer(uncut, scenario.design);
+  std::vector<double> vector_ms, value_ms, equilibrate_ms, update_ms;
+  int preview_iterations = 0;
+  std::vector<Vec3> picture_mm;  // deformed render surface vertices: what the page draws
+  for (int edit = 0; edit < repeat; ++edit) {
+    update_ms.push_back(wall_time_ms([&] {
+      designer.move_stroke(0, stroke_of_edit(scenario, edit));
+      const StaticResult solved = solve_static(preview.model, preview.stiffness, designer.result().stress_kPa, StaticOptions{});
+      picture_mm = deformed_positions(preview.surface, preview.model.volume, solved.displacement_mm);
+      preview_iterations = solved.report.iterations;
+    }));
+    const DesignTimings& t = designer.result().timings;
+    vector_ms.push_back(kMsPerSecond * t.directions_s);
+    value_ms.push_back(kMsPerSecond * t.eigenvalues_s);
+    equilibrate_ms.push_back(kMsPerSecond * t.equilibration_s);
+  }
+  DesignOutcome out;
+  out.vector.time = summarize_timings(vector_ms);
+  out.value.time = summarize_timings(value_ms);
+  out.value.iterations = designer.result().eigenvalue_iterations;
+  out.equilibrate.time = summarize_timings(equilibrate_ms);
+  out.update.time = summarize_timings(update_ms);
+  out.update.iterations = preview_iterations;
+  out.line_tensors = frame_line_tensors(designer.result().frames);
+  out.eigenvalues_kPa = flatten_eigenvalues(designer.result().eigenvalues_kPa);
+  return out;
+}
+
+DesignOutcome measure_paper(const TissueModel& uncut, const BenchScenario& scenario, int repeat) {
+  const ImplementationScope one_thread(Implementation::paper);
+  StressDesign design = scenario.design;
+  design.solver = EigenvalueSolver::paper_cg;
+  StressDesigner designer(uncut, design);
+  PaperDirections directions(uncut, design);
+  directions.interpolate(design.strokes);  // the paper's fields of the initial design: the warm start
+  std::vector<double> vector_ms, value_ms;
+  PaperDirectionResult paper_frames;
+  for (int edit = 0; edit < repeat; ++edit) {
+    std::vector<DesignStroke> strokes = design.strokes;
+    strokes.front() = stroke_of_edit(scenario, edit);
+    vector_ms.push_back(wall_time_ms([&] { paper_frames = directions.interpolate(strokes); }));
+    designer.move_stroke(0, strokes.front());
+    value_ms.push_back(kMsPerSecond * designer.result().timings.eigenvalues_s);
+  }
+  DesignOutcome out;
+  out.vector.time = summarize_timings(vector_ms);
+  out.vector.iterations = paper_frames.iterations;
+  out.value.time = summarize_timings(value_ms);
+  out.value.iterations = designer.result().eigenvalue_iterations;
+  out.equilibrate.skipped = "the paper has no equilibration step";
+  out.line_tensors = frame_line_tensors(paper_frames.frames);
+  out.eigenvalues_kPa = flatten_eigenvalues(designer.result().eigenvalues_kPa);
+  return out;
+}
+
+}  // namespace
+
+DesignOutcome measure_design(const TissueModel& uncut, const BenchScenario& scenario, Implementation implementation,
+                             int repeat) {
+  repeat = std::max(repeat, 1);
+  switch (implementation) {
+    case Implementation::cleave: return measure_cleave(uncut, scenario, repeat);
+    case Implementation::paper: return measure_paper(uncut, scenario, repeat);
+    case Implementation::eigen_cg:
+    case Implementation::cholmod: break;
+  }
+  DesignOutcome out;
+  const std::string why = "cleave's design stages already use CHOLMOD (supernodal, analysis reused)";
+  out.vector.skipped = out.value.skipped = out.equilibrate.skipped = why;
+  return out;
+}
+
+}  // namespace cleave::bench
