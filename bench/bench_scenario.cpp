@@ -46,7 +46,18 @@ CutRequests spread_incisions(const BodySurface& surface, const TissueModel& mode
   pattern.spacing_mm = kIncisionSpacingRadii * pattern.radius_mm;
   pattern.depth_mm = incision_depth_mm(surface, top_point(surface, model, centre.x(), centre.z()));
   CutRequests requests;
-  requests.incisions = place_incisions(surface, pattern);
+  // place_incisions may accept a rim that plan_cuts then refuses near the body's ends (reported
+  // to the cut owner); keep only incisions the cut plan accepts.
+  for (const RoundIncision& incision : place_incisions(surface, pattern)) {
+    CutRequests one;
+    one.incisions.push_back(incision);
+    try {
+      plan_cuts(surface, one);
+    } catch (const InputError&) {
+      continue;
+    }
+    requests.incisions.push_back(incision);
+  }
   return requests;
 }
 
