@@ -9,6 +9,8 @@ packages=(
   # numerics and utilities
   libeigen3-dev libtbb-dev nlohmann-json3-dev libcli11-dev libfmt-dev
   libsuitesparse-dev
+  # optimized BLAS/LAPACK for CHOLMOD's supernodal factorization (the reference libblas3 is ~5-10x slower)
+  libopenblas0-pthread
   # tests and benchmarks
   libgtest-dev libgmock-dev libbenchmark-dev gnuplot-nox
   # model formats: volumes (NRRD, NIfTI), meshes, voxelization
