@@ -83,7 +83,7 @@ TEST(CaseMechanics, BadSimulationFieldsAreNamed) {
   EXPECT_EQ(simulation_error(R"({"fixed": {"box_mm": [[1, 0, 0], [0, 1, 1]]}})"),
             "case.json: /simulation/fixed/box_mm is [[1,0,0],[0,1,1]]; expected a lower corner [x0, y0, z0] not above the upper corner [x1, y1, z1]");
   EXPECT_EQ(simulation_error(R"({"fixed": "left"})"),
-            "case.json: /simulation/fixed is \"left\"; expected \"none\", \"free\", {\"box_mm\": [[x0, y0, z0], [x1, y1, z1]]} or an array of such boxes");
+            "case.json: /simulation/fixed is \"left\"; expected \"none\", \"free\", {\"box_mm\": [[x0, y0, z0], [x1, y1, z1]]}, {\"surface\": \"inner\"} or an array of such");
   EXPECT_EQ(simulation_error(R"({"time_step": 0.1})"),
             "case.json: /simulation has unknown key 'time_step'; expected one of: mode, solver, tolerance, max_iterations, "
             "time_step_s, steps, steps_per_frame, frames_every, damping, fixed, gravity_mm_per_s2");

@@ -127,10 +127,14 @@ std::vector<SurfacePoint> BodySurface::samples(SurfaceSide side) const {
   for (std::size_t i = 0; i < face_centre_mm_.size(); ++i) {
     const auto s = project(face_centre_mm_[i], cell_size_mm());
     const SurfacePoint p = s ? *s : SurfacePoint{face_centre_mm_[i], face_normal_[i]};
-    if (side == SurfaceSide::outer && p.normal.dot(p.position_mm - body_centre_mm_) <= 0) continue;
+    if (side != SurfaceSide::all && side_of(p) != side) continue;
     out.push_back(p);
   }
   return out;
+}
+
+SurfaceSide BodySurface::side_of(const SurfacePoint& p) const {
+  return p.normal.dot(p.position_mm - body_centre_mm_) > 0 ? SurfaceSide::outer : SurfaceSide::inner;
 }
 
 double BodySurface::thickness_mm(const Vec3& p_mm, const Vec3& inward) const {

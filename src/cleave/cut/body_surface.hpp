@@ -16,7 +16,8 @@
 //
 // "Outer" side: a surface point whose outward normal points away from the centre of the body's
 // bounding box. For the shells cleave models (tube, abdomen) this is the skin and excludes the
-// inner surface; for a plate it is both faces.
+// inner surface; for a plate it is both faces. "Inner" side: every other surface point (the
+// tube's bore, the abdominal wall's deep face lying on the body beneath; none for a plate).
 #include <Eigen/Geometry>
 #include <optional>
 #include <vector>
@@ -32,6 +33,7 @@ struct SurfacePoint {
 
 enum class SurfaceSide {
   outer,  ///< facing away from the bounding-box centre (the skin of a shell)
+  inner,  ///< facing towards it (the deep face of a shell)
   all,    ///< every boundary face
 };
 
@@ -51,6 +53,8 @@ class BodySurface {
   /// One surface point per boundary voxel face on `side`, at the face centre projected onto the
   /// surface, in a deterministic order.
   std::vector<SurfacePoint> samples(SurfaceSide side) const;
+  /// The side (outer or inner) that surface point p lies on, by its outward normal.
+  SurfaceSide side_of(const SurfacePoint& p) const;
   /// Distance (mm) from surface point p along unit direction `inward` until the body is left
   /// (marching in quarter-cell steps from the first point inside); 0 when the ray never enters.
   double thickness_mm(const Vec3& p_mm, const Vec3& inward) const;

@@ -33,7 +33,13 @@ SolverKind parse_solver(const nlohmann::json& value, const JsonPath& at) {
   json_error(at, value, kExpected);
 }
 
-FixedBox parse_box(const nlohmann::json& value, const JsonPath& at) {
+void parse_fixed_entry(const nlohmann::json& value, const JsonPath& at, SimulationSettings& s) {
+  if (const nlohmann::json* surface = value.is_object() ? json_find(value, "surface") : nullptr) {
+    json_allow_keys(value, at, {"surface"});
+    if (!surface->is_string() || surface->get<std::string>() != "inner") json_error(at / "surface", *surface, "\"inner\"");
+    s.fixed_surfaces.push_back(FixedSurface::inner);
+    return;
+  }
   json_allow_keys(value, at, {"box_mm"});
   const nlohmann::json* box = json_find(value, "box_mm");
   if (!box) json_missing(at / "box_mm", "[[x0, y0, z0], [x1, y1, z1]] (mm)");
@@ -41,21 +47,20 @@ FixedBox parse_box(const nlohmann::json& value, const JsonPath& at) {
   FixedBox out{json_vec3((*box)[0], at / "box_mm" / 0), json_vec3((*box)[1], at / "box_mm" / 1)};
   if ((out.lo_mm.array() > out.hi_mm.array()).any())
     json_error(at / "box_mm", *box, "a lower corner [x0, y0, z0] not above the upper corner [x1, y1, z1]");
-  return out;
+  s.fixed_boxes.push_back(out);
 }
 
-std::vector<FixedBox> parse_fixed(const nlohmann::json& value, const JsonPath& at) {
-  constexpr const char* kExpected = "\"none\", \"free\", {\"box_mm\": [[x0, y0, z0], [x1, y1, z1]]} or an array of such boxes";
+void parse_fixed(const nlohmann::json& value, const JsonPath& at, SimulationSettings& s) {
+  constexpr const char* kExpected =
+      "\"none\", \"free\", {\"box_mm\": [[x0, y0, z0], [x1, y1, z1]]}, {\"surface\": \"inner\"} or an array of such";
   if (value.is_string()) {
-    const std::string s = value.get<std::string>();
-    if (s == "none" || s == "free") return {};
+    const std::string name = value.get<std::string>();
+    if (name == "none" || name == "free") return;
     json_error(at, value, kExpected);
   }
-  if (value.is_object()) return {parse_box(value, at)};
+  if (value.is_object()) return parse_fixed_entry(value, at, s);
   if (!value.is_array()) json_error(at, value, kExpected);
-  std::vector<FixedBox> boxes;
-  for (std::size_t i = 0; i < value.size(); ++i) boxes.push_back(parse_box(value[i], at / i));
-  return boxes;
+  for (std::size_t i = 0; i < value.size(); ++i) parse_fixed_entry(value[i], at / i, s);
 }
 
 Vec6 parse_voigt_kPa(const nlohmann::json& value, const JsonPath& at) {
@@ -98,7 +103,7 @@ SimulationSettings parse_simulation_settings(const CaseFile& case_file) {
     if (const auto* v = json_find(*d, "stiffness_s"))
       s.stiffness_damping_s = json_number_in(*v, here / "stiffness_s", 0.0, kInf, "a non-negative stiffness damping in s");
   }
-  if (const auto* v = json_find(*section, "fixed")) s.fixed_boxes = parse_fixed(*v, at / "fixed");
+  if (const auto* v = json_find(*section, "fixed")) parse_fixed(*v, at / "fixed", s);
   if (const auto* v = json_find(*section, "gravity_mm_per_s2")) s.gravity_mm_per_s2 = json_vec3(*v, at / "gravity_mm_per_s2");
   return s;
 }

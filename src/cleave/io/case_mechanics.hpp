@@ -10,7 +10,10 @@
 //     "steps_per_frame": 10,                         dynamic: Newmark steps per displayed frame
 //     "frames_every": 1,                             dynamic: write every n-th frame as frame_NNNN.vtu (0 = none)
 //     "damping": {"mass_per_s": 0, "stiffness_s": 0},   Rayleigh D = alpha M + beta K
-//     "fixed": "none" | "free" | {"box_mm": [[x0,y0,z0],[x1,y1,z1]]} | [ {"box_mm": ...}, ... ],
+//     "fixed": "none" | "free" | {"box_mm": [[x0,y0,z0],[x1,y1,z1]]} | {"surface": "inner"}
+//              | [ {"box_mm": ...}, {"surface": "inner"}, ... ],
+//              "inner": every vertex on the body's inner surface (a shell's deep face, lying on
+//              the body beneath; cut/body_surface.hpp), held in addition to the boxes
 //     "gravity_mm_per_s2": [0, 0, -9810]              default none
 //   }
 //   "residual_stress": {"uniform_kPa": [xx, yy, zz, xy, xz, yz]}
@@ -35,6 +38,9 @@ struct FixedBox {
   Vec3 hi_mm = Vec3::Zero();
 };
 
+/// A whole side of the body's surface held ({"surface": "inner"}).
+enum class FixedSurface { inner };
+
 struct SimulationSettings {
   SimulationMode mode = SimulationMode::static_equilibrium;
   SolverKind solver = SolverKind::multigrid_cg;
@@ -45,7 +51,8 @@ struct SimulationSettings {
   int frames_every = 1;
   double mass_damping_per_s = 0;
   double stiffness_damping_s = 0;
-  std::vector<FixedBox> fixed_boxes;  ///< empty = free body ("none" / "free")
+  std::vector<FixedBox> fixed_boxes;  ///< empty (and no fixed_surfaces) = free body ("none" / "free")
+  std::vector<FixedSurface> fixed_surfaces;
   Vec3 gravity_mm_per_s2 = Vec3::Zero();
 };
 

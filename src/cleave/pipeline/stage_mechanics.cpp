@@ -1,6 +1,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/units.hpp"
+#include "cleave/cut/surface_side_vertices.hpp"
 #include "cleave/fem/cell_stress.hpp"
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
@@ -12,10 +13,18 @@
 namespace cleave {
 namespace {
 
-std::vector<VertexId> held_vertices(const LinkedVolume& volume, const SimulationSettings& s) {
+std::vector<VertexId> held_vertices(const TissueModel& model, const SimulationSettings& s) {
+  const LinkedVolume& volume = model.volume;
   std::vector<std::uint8_t> held(static_cast<std::size_t>(volume.vertex_count()), 0);
   for (const FixedBox& box : s.fixed_boxes)
     for (const VertexId v : vertices_in_box(volume, box.lo_mm, box.hi_mm)) held[static_cast<std::size_t>(v)] = 1;
+  if (!s.fixed_surfaces.empty()) {
+    const BodySurface surface(model);
+    for (const FixedSurface side : s.fixed_surfaces) {
+      const SurfaceSide which = side == FixedSurface::inner ? SurfaceSide::inner : SurfaceSide::all;
+      for (const VertexId v : surface_side_vertices(surface, which)) held[static_cast<std::size_t>(v)] = 1;
+    }
+  }
   std::vector<VertexId> out;
   for (VertexId v = 0; v < volume.vertex_count(); ++v)
     if (held[static_cast<std::size_t>(v)]) out.push_back(v);
@@ -57,7 +66,7 @@ void stage_mechanics(RunContext& ctx) {
   const LinkedVolume& volume = ctx.model.volume;
   if (ctx.residual_stress_kPa.empty())
     if (auto direct = parse_direct_residual_stress(ctx.case_file, ctx.model)) ctx.residual_stress_kPa = std::move(*direct);
-  const std::vector<VertexId> held = held_vertices(volume, settings);
+  const std::vector<VertexId> held = held_vertices(ctx.model, settings);
   const bool loaded = !ctx.residual_stress_kPa.empty() || !settings.gravity_mm_per_s2.isZero();
   nlohmann::json summary = {{"mode", settings.mode == SimulationMode::dynamic ? "dynamic" : "static"},
                             {"fixed_vertices", held.size()}};
