@@ -1,27 +1,30 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/cut/body_surface.hpp"
 #include "cleave/io/gltf_writer.hpp"
 #include "cleave/io/ply_writer.hpp"
 #include "cleave/pipeline/stages.hpp"
 #include "cleave/surface/render_surface.hpp"
 #include "cleave/surface/surface_mesh.hpp"
 #include "cleave/surface/surface_topology.hpp"
+#include "cleave/viz/cut_face_surface_arrays.hpp"
 
 namespace cleave {
 
 // The render surface of the cut body, deformed by the mechanics stage's displacement (if any),
-// as surface.ply (with the triangle arrays "is_cut" and "cell") and surface.gltf. Summary:
+// as surface.ply (with the triangle arrays "is_cut" and "cell", and the cut-face colouring of
+// viz/cut_face_surface_arrays.hpp: "cut_face_depth", "released_traction_kPa" on triangles and
+// vertices, vertex colours by released traction) and surface.gltf (the vertex arrays). Summary:
 //   surface: {vertices, triangles, cut_triangles, closed_components, closed}
 //   files:   the paths written, appended to the array
 void stage_surface(RunContext& ctx) {
   const RenderSurface surface = build_render_surface(ctx.model);
   const std::vector<Vec3> positions = deformed_positions(surface, ctx.model.volume, ctx.displacement_mm);
-  const SurfaceMesh mesh = make_surface_mesh(surface, positions);
+  SurfaceMesh mesh = make_surface_mesh(surface, positions);
+  const std::int64_t cut_triangles = attach_cut_face_arrays(mesh, surface, BodySurface(ctx.model), ctx.residual_stress_kPa);
 
   const SurfaceTopology topology = surface_topology(surface.triangles, surface.vertex_count());
-  std::int64_t cut_triangles = 0;
-  for (std::int32_t t = 0; t < surface.triangle_count(); ++t) cut_triangles += surface.triangle_is_cut(t) ? 1 : 0;
   ctx.summary["surface"] = {{"vertices", surface.vertex_count()},
                             {"triangles", surface.triangle_count()},
                             {"cut_triangles", cut_triangles},

@@ -1,15 +1,23 @@
 #include "cleave/viz/cut_face_colouring.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <limits>
 
 namespace cleave {
 namespace {
 
+/// Distance from p to the tangent plane of the nearest sample: exact on a flat or gently curved
+/// surface, where the distance to the nearest sample point would overestimate by up to half a
+/// cell (samples are face centres).
 double nearest_distance(std::span<const SurfacePoint> samples, const Vec3& p) {
   double best = std::numeric_limits<double>::infinity();
-  for (const SurfacePoint& s : samples) best = std::min(best, (s.position_mm - p).squaredNorm());
-  return std::sqrt(best);
+  const SurfacePoint* nearest = nullptr;
+  for (const SurfacePoint& s : samples) {
+    const double d = (s.position_mm - p).squaredNorm();
+    if (d < best) best = d, nearest = &s;
+  }
+  return nearest ? std::abs(nearest->normal.dot(p - nearest->position_mm)) : best;
 }
 
 }  // namespace
@@ -30,15 +38,8 @@ std::array<float, 3> red_blue(double value, double lo, double hi) {
 }
 
 std::vector<double> depth_between_skin_and_inner_layer(const BodySurface& surface, std::span<const Vec3> points_mm) {
-  const std::vector<SurfacePoint> all = surface.samples(SurfaceSide::all);
   const std::vector<SurfacePoint> skin = surface.samples(SurfaceSide::outer);
-  std::vector<SurfacePoint> inner;
-  for (const SurfacePoint& s : all) {
-    const bool is_skin = std::any_of(skin.begin(), skin.end(), [&](const SurfacePoint& k) {
-      return (k.position_mm - s.position_mm).squaredNorm() == 0;
-    });
-    if (!is_skin) inner.push_back(s);
-  }
+  const std::vector<SurfacePoint> inner = surface.samples(SurfaceSide::inner);
   std::vector<double> out;
   out.reserve(points_mm.size());
   for (const Vec3& p : points_mm) {

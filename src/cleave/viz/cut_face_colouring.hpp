@@ -2,8 +2,9 @@
 // Colouring the new cut surfaces (paper section 5, fig. 5 middle and right):
 //   depth      0 at the skin, 1 at the inner layer. Interpolated between the two surfaces by
 //              inverse distance: depth = d_skin / (d_skin + d_inner), with d_skin the distance to
-//              the nearest outer (skin) surface sample and d_inner to the nearest inner one; a
-//              body with no inner side (a plate) uses d_skin / thickness under that point.
+//              the tangent plane of the nearest outer (skin) surface sample and d_inner that of the
+//              nearest inner one (BodySurface sides); a body with no inner side (a plate) uses
+//              d_skin / thickness under that point.
 //   released traction ||sigma n|| (kPa) with n the cut face's normal: the residual stress the cut
 //              released there; red for the highest, blue for the lowest (linear map).
 //
