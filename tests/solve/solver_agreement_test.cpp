@@ -81,8 +81,9 @@ TEST(SolverAgreement, NonConvergenceIsReportedWithTheResidualAndNoNaN) {
     EXPECT_EQ(r.iterations, 1) << solver->name();
     EXPECT_GT(r.relative_residual, starved.relative_tolerance) << solver->name();
     EXPECT_TRUE(x.allFinite()) << solver->name();
-    // The residual reported is the true one of the x handed back.
-    EXPECT_NEAR(r.relative_residual, (s.b - s.a * x).norm() / s.b.norm(), 1e-12 * r.relative_residual) << solver->name();
+    // The residual reported is the true one of the x handed back (up to the rounding of b - A x,
+    // which is relative to ||b||: the solver sums A x by 3x3 blocks, Eigen here by rows).
+    EXPECT_NEAR(r.relative_residual, (s.b - s.a * x).norm() / s.b.norm(), 1e-11) << solver->name();
   }
 }
 

@@ -51,6 +51,7 @@ void Dynamics::rebuild_topology() {
     const auto* end = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[row + 1];
     diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - stiffness_.innerIndexPtr();
   }
+  solver_ready_ = false;  // new pattern: the next step sets the solver up afresh
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
   update_rotations();
 }
@@ -206,7 +207,12 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    solver_->setup(system_, model_.volume);
+    if (solver_ready_) {
+      solver_->update_values(system_, model_.volume);  // same pattern: the solver keeps its structure
+    } else {
+      solver_->setup(system_, model_.volume);
+      solver_ready_ = true;
+    }
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

@@ -9,7 +9,9 @@
 // unrotated (reference) frame and rotated into the world: the residual stress tensor is attached
 // to the material and turns with it. The step linearizes f_int at the current state with R fixed
 // (stiffness K_R = sum R K^e R^T) and solves one linear system per step with the chosen solver,
-// warm-started from the Newmark predictor of the previous state.
+// warm-started from the Newmark predictor of the previous state. K_R is re-gathered in place on
+// a pattern kept until the topology changes, and the solver is only told the new values
+// (LinearSolver::update_values: the multigrid keeps its levels, CHOLMOD its analysis).
 //
 //   Dynamics sim(model, stress_kPa, settings);   // model must outlive sim
 //   for (int i = 0; i < n; ++i) sim.step(1e-3);
@@ -94,6 +96,7 @@ class Dynamics {
   SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; same pattern as stiffness_
   std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
   bool any_fixed_ = false;
+  bool solver_ready_ = false;  ///< set up on the current pattern (later steps only update values)
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;
   double time_s_ = 0;

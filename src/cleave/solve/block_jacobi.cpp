@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/LU>
+#include <algorithm>
 #include <cmath>
 
 #include "cleave/core/error.hpp"
@@ -16,7 +17,34 @@ constexpr std::size_t kVerticesPerTask = 1024;
 /// A block counts as singular when |det| falls below this times its norm cubed (scale free).
 constexpr double kRelativeDeterminantFloor = 1e-14;
 
+/// The inverse of a vertex block, or the identity when it is singular (no NaN ever).
+Mat3 inverse_or_identity(const Mat3& block) {
+  Mat3 inverse;
+  bool invertible = false;
+  double determinant = 0;
+  const double scale = block.norm();
+  block.computeInverseAndDetWithCheck(inverse, determinant, invertible, kRelativeDeterminantFloor * scale * scale * scale);
+  return (invertible && inverse.allFinite()) ? inverse : Mat3::Identity();
+}
+
 }  // namespace
+
+std::vector<Mat3f> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
+  const auto vertices = static_cast<std::size_t>(a.block_rows());
+  std::vector<Mat3f> out(vertices);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t v = range.begin(); v < range.end(); ++v) {
+      const auto first = a.column.begin() + a.row_start[v];
+      const auto last = a.column.begin() + a.row_start[v + 1];
+      const auto found = std::lower_bound(first, last, static_cast<std::int32_t>(v));
+      Mat3 block = Mat3::Zero();
+      if (found != last && *found == static_cast<std::int32_t>(v))
+        block = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * (found - a.column.begin()));
+      out[v] = inverse_or_identity(block).cast<float>();
+    }
+  });
+  return out;
+}
 
 BlockJacobi block_jacobi(const SparseMatrix& a) {
   if (a.rows() % 3 != 0 || a.rows() != a.cols())
@@ -37,12 +65,7 @@ BlockJacobi block_jacobi(const SparseMatrix& a) {
           const auto column = static_cast<Eigen::Index>(inner[k]) - first;
           if (column >= 0 && column < 3) block(i, column) = values[k];
         }
-      Mat3 inverse;
-      bool invertible = false;
-      double determinant = 0;
-      const double scale = block.norm();
-      block.computeInverseAndDetWithCheck(inverse, determinant, invertible, kRelativeDeterminantFloor * scale * scale * scale);
-      d.inverse_blocks[v] = (invertible && inverse.allFinite()) ? inverse : Mat3::Identity();
+      d.inverse_blocks[v] = inverse_or_identity(block);
     }
   });
   return d;

@@ -12,6 +12,7 @@
 #include <vector>
 
 #include "cleave/core/types.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/conjugate_gradient.hpp"
 
 namespace cleave {
@@ -23,5 +24,8 @@ class BlockJacobi final : public Preconditioner {
 };
 
 BlockJacobi block_jacobi(const SparseMatrix& a);
+
+/// The same inverse blocks, from a block CSR matrix, in single precision (the smoother's D^-1).
+std::vector<Mat3f> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a);
 
 }  // namespace cleave

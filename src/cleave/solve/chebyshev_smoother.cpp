@@ -1,15 +1,40 @@
 #include "cleave/solve/chebyshev_smoother.hpp"
 
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <cmath>
 
 #include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
+namespace {
+
+constexpr Eigen::Index kEntriesPerTask = 1 << 14;
+
+std::vector<Mat3f> single_precision(const BlockJacobi& d) {
+  std::vector<Mat3f> out(d.inverse_blocks.size());
+  for (std::size_t v = 0; v < out.size(); ++v) out[v] = d.inverse_blocks[v].cast<float>();
+  return out;
+}
+
+/// d = c_d d + c_z z; x += d (or x = d when `assign`), in parallel chunks.
+void update_direction(float c_d, float c_z, const Eigen::VectorXf& z, Eigen::VectorXf& d, Eigen::VectorXf& x, bool assign) {
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, z.size(), kEntriesPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    const Eigen::Index n = r.end() - r.begin();
+    auto ds = d.segment(r.begin(), n);
+    ds = c_d * ds + c_z * z.segment(r.begin(), n);
+    if (assign) x.segment(r.begin(), n) = ds;
+    else x.segment(r.begin(), n) += ds;
+  });
+}
+
+}  // namespace
 
 ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const ChebyshevOptions& options) {
   ChebyshevSmoother s;
   s.options = options;
-  s.diagonal = block_jacobi(a);
+  const BlockJacobi diagonal = block_jacobi(a);
   // Power iteration on D^-1 A from a fixed, non-special start vector (deterministic).
   const Eigen::Index n = a.rows();
   Vector x(n), y(n), z(n);
@@ -20,48 +45,59 @@ ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const Chebyshev
     if (!(norm > 0) || !std::isfinite(norm)) break;
     x /= norm;
     multiply(a, x, y);
-    s.diagonal.apply(y, z);
+    diagonal.apply(y, z);
     estimate = x.dot(z);  // Rayleigh-like quotient (x normalised)
     x = z;
   }
   const double growth = x.norm();
   if (std::isfinite(growth) && growth > estimate) estimate = growth;
   s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+  s.inverse_diagonal = single_precision(diagonal);
   return s;
 }
 
-void ChebyshevSmoother::smooth_from_zero(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work) const {
+void ChebyshevSmoother::smooth_from_zero(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                                         ChebyshevWork& work) const {
   iterate(a, b, x, work, Start::from_zero);
 }
 
-void ChebyshevSmoother::smooth(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work) const {
+void ChebyshevSmoother::smooth(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                               ChebyshevWork& work) const {
   iterate(a, b, x, work, Start::from_x);
 }
 
 // Chebyshev iteration on [lower, upper] (Saad, Iterative Methods, algorithm 12.1) with D^-1.
-void ChebyshevSmoother::iterate(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work,
-                                Start start) const {
+void ChebyshevSmoother::iterate(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                                ChebyshevWork& work, Start start) const {
   const double upper = lambda_max;
   const double lower = lambda_max / options.smoothing_range;
   const double theta = 0.5 * (upper + lower);
   const double delta = 0.5 * (upper - lower);
   const double sigma = theta / delta;
   double rho = 1.0 / sigma;
+  const Eigen::Index n = b.size();
+  work.d.resize(n);
   if (start == Start::from_zero) {
-    work.r = b;
-    x.setZero(b.size());
+    x.resize(n);
+    work.z.resize(n);
+    const auto blocks = static_cast<std::size_t>(n / 3);
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, kEntriesPerTask / 3), [&](const tbb::blocked_range<std::size_t>& r) {
+      for (std::size_t v = r.begin(); v < r.end(); ++v) {
+        const auto i = static_cast<Eigen::Index>(3 * v);
+        work.z.segment<3>(i) = inverse_diagonal[v] * b.segment<3>(i);
+      }
+    });
+    work.d.setZero();
+    update_direction(0.0f, static_cast<float>(1.0 / theta), work.z, work.d, x, true);
   } else {
-    residual(a, b, x, work.r);
+    jacobi_residual(a, inverse_diagonal, b, x, work.z);
+    work.d.setZero();
+    update_direction(0.0f, static_cast<float>(1.0 / theta), work.z, work.d, x, false);
   }
-  diagonal.apply(work.r, work.z);
-  work.d = work.z / theta;
-  x += work.d;
   for (int k = 1; k < options.degree; ++k) {
-    residual(a, b, x, work.r);
-    diagonal.apply(work.r, work.z);
+    jacobi_residual(a, inverse_diagonal, b, x, work.z);
     const double rho_next = 1.0 / (2.0 * sigma - rho);
-    work.d = (rho_next * rho) * work.d + (2.0 * rho_next / delta) * work.z;
-    x += work.d;
+    update_direction(static_cast<float>(rho_next * rho), static_cast<float>(2.0 * rho_next / delta), work.z, work.d, x, false);
     rho = rho_next;
   }
 }

@@ -3,14 +3,18 @@
 // polynomial in D^-1 A (D = 3x3 vertex diagonal blocks) that damps the error components whose
 // eigenvalues lie in [lambda_max / smoothing_range, lambda_max]. Being a fixed polynomial, the
 // same smoother before and after the coarse correction keeps the V-cycle symmetric (a valid CG
-// preconditioner); every step is one parallel sparse product.
+// preconditioner); every step is one parallel pass over the matrix (residual and D^-1 fused).
 //
-//   ChebyshevSmoother s = make_chebyshev_smoother(a, options);
-//   s.smooth_from_zero(a, b, x, work);   // x = p(D^-1 A) D^-1 b
-//   s.smooth(a, b, x, work);             // x += p(D^-1 A) D^-1 (b - A x)
+//   ChebyshevSmoother s = make_chebyshev_smoother(a, options);   // a: double CSR (estimate)
+//   s.smooth_from_zero(blocks, b, x, work);   // x = p(D^-1 A) D^-1 b       (blocks: a in float)
+//   s.smooth(blocks, b, x, work);             // x += p(D^-1 A) D^-1 (b - A x)
 //
-// lambda_max of D^-1 A is estimated by power iteration and enlarged by a safety factor.
+// Smoothing runs in single precision on the block CSR copy of a (block_sparse_matrix.hpp): it is
+// part of a preconditioner, whose rounding the outer double-precision CG absorbs, and it halves
+// the bytes streamed. lambda_max of D^-1 A is estimated by power iteration (double) and enlarged
+// by a safety factor.
 #include "cleave/solve/block_jacobi.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 
 namespace cleave {
 
@@ -22,21 +26,22 @@ struct ChebyshevOptions {
 };
 
 struct ChebyshevWork {
-  Vector r, d, z;
+  Eigen::VectorXf d, z;
 };
 
 class ChebyshevSmoother {
  public:
-  BlockJacobi diagonal;
+  std::vector<Mat3f> inverse_diagonal;  ///< per vertex: D^-1 block (single precision)
   double lambda_max = 1;  ///< upper end of the damped interval (safety factor included)
   ChebyshevOptions options;
 
-  void smooth_from_zero(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work) const;
-  void smooth(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work) const;
+  void smooth_from_zero(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work) const;
+  void smooth(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work) const;
 
  private:
   enum class Start { from_zero, from_x };
-  void iterate(const SparseMatrix& a, const Vector& b, Vector& x, ChebyshevWork& work, Start start) const;
+  void iterate(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work,
+               Start start) const;
 };
 
 ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const ChebyshevOptions& options = {});

@@ -2,6 +2,7 @@
 
 #include <cmath>
 
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
@@ -14,7 +15,8 @@ constexpr int kMaxRestarts = 2;
 enum class CgStop { converged_recurrence, out_of_iterations, breakdown };
 
 /// Plain PCG from x; `iterations` is increased by the iterations done.
-CgStop run_pcg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double target,
+template <typename Matrix>
+CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double target,
                int max_iterations, int& iterations) {
   const Eigen::Index n = a.rows();
   Vector r(n), z(n), p(n), q(n);
@@ -42,10 +44,9 @@ CgStop run_pcg(const SparseMatrix& a, const Vector& b, Vector& x, const Precondi
   return CgStop::out_of_iterations;
 }
 
-}  // namespace
-
-SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
-                              const SolveSettings& settings) {
+template <typename Matrix>
+SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                                  const SolveSettings& settings) {
   SolveReport report;
   const Eigen::Index n = a.rows();
   if (x.size() != n || !x.allFinite()) x = Vector::Zero(n);
@@ -69,6 +70,18 @@ SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x,
   report.relative_residual = r_norm / b_norm;
   report.converged = report.relative_residual <= settings.relative_tolerance;
   return report;
+}
+
+}  // namespace
+
+SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings) {
+  return preconditioned_cg_any(a, b, x, preconditioner, settings);
+}
+
+SolveReport preconditioned_cg(const BlockSparseMatrix<double>& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings) {
+  return preconditioned_cg_any(a, b, x, preconditioner, settings);
 }
 
 }  // namespace cleave

@@ -42,6 +42,12 @@ class LinearSolver {
   /// Prepares for A (factorization, hierarchy). `topology` is the linked volume whose vertices
   /// the dofs belong to; it must stay alive and unchanged until the next setup.
   virtual void setup(const SparseMatrix& a, const LinkedVolume& topology) = 0;
+  /// Like setup() for a matrix with the same sparsity pattern and topology as the last setup and
+  /// new values (the next time step's corotated stiffness). Solvers keep what depends only on
+  /// the pattern (CHOLMOD's symbolic analysis, the multigrid's levels, which it refreshes only
+  /// when its iterations grow: a stale preconditioner still gives the exact solution).
+  /// The default sets up from scratch.
+  virtual void update_values(const SparseMatrix& a, const LinkedVolume& topology) { setup(a, topology); }
   /// Solves A x = b; x holds the initial guess on entry (warm start) and the solution on exit.
   /// Never leaves NaN in x: on divergence x keeps its last finite iterate and converged = false.
   virtual SolveReport solve(const Vector& b, Vector& x) = 0;

@@ -2,7 +2,10 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
+
 #include "cleave/core/error.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/conjugate_gradient.hpp"
 #include "cleave/solve/multigrid_preconditioner.hpp"
 
@@ -18,12 +21,33 @@ class MultigridCgSolver final : public LinearSolver {
     a_ = a;
     a_.makeCompressed();
     preconditioner_ = build_multigrid(a_, topology, options_);
+    a_blocks_ = to_block_sparse<double>(a_);
+    stale_updates_ = 0;
+    baseline_iterations_ = -1;
+    rebuild_requested_ = false;
+  }
+
+  void update_values(const SparseMatrix& a, const LinkedVolume& topology) override {
+    const bool same_pattern = a.isCompressed() && a.rows() == a_.rows() && a.nonZeros() == a_.nonZeros() &&
+                              std::equal(a_.outerIndexPtr(), a_.outerIndexPtr() + a_.rows() + 1, a.outerIndexPtr());
+    if (!same_pattern || rebuild_requested_ || stale_updates_ >= options_.max_stale_updates) {
+      setup(a, topology);
+      return;
+    }
+    // Only the block copy follows the new values: a_ (scalar CSR) is what the levels were built
+    // from and is read again only by the next setup.
+    refresh_block_values(a, a_blocks_);
+    preconditioner_.refresh_fine_level(a_blocks_);
+    ++stale_updates_;
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
     if (b.size() != a_.rows())
       throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));
-    return preconditioned_cg(a_, b, x, preconditioner_, settings_);
+    const SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_, settings_);
+    if (baseline_iterations_ < 0) baseline_iterations_ = report.iterations;
+    else if (report.iterations > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
+    return report;
   }
 
   std::string_view name() const override { return "multigrid"; }
@@ -31,8 +55,12 @@ class MultigridCgSolver final : public LinearSolver {
  private:
   SolveSettings settings_;
   MultigridOptions options_;
-  SparseMatrix a_;
+  SparseMatrix a_;                      ///< the matrix of the last setup (the levels' source)
+  BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the CG multiplies with
   MultigridPreconditioner preconditioner_;
+  int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
+  int baseline_iterations_ = -1;  ///< iterations of the first solve after the build
+  bool rebuild_requested_ = false;
 };
 
 }  // namespace

@@ -9,6 +9,7 @@
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
 #include "cleave/solve/grid_level.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
@@ -29,14 +30,19 @@ MultigridPreconditioner::~MultigridPreconditioner() = default;
 MultigridPreconditioner::MultigridPreconditioner(MultigridPreconditioner&&) noexcept = default;
 MultigridPreconditioner& MultigridPreconditioner::operator=(MultigridPreconditioner&&) noexcept = default;
 
-void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine) {
+namespace {
+
+template <typename VectorType>
+void prolongate_add_any(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const VectorType& coarse,
+                        VectorType& fine) {
+  using Scalar = typename VectorType::Scalar;
   const auto vertices = static_cast<std::size_t>(p.fine_count());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t v = range.begin(); v < range.end(); ++v) {
-      Vec3 sum = Vec3::Zero();
+      Eigen::Matrix<Scalar, 3, 1> sum = Eigen::Matrix<Scalar, 3, 1>::Zero();
       for (int e = p.fine_start[v]; e < p.fine_start[v + 1]; ++e) {
         const auto& entry = p.by_fine[static_cast<std::size_t>(e)];
-        sum += entry.weight * coarse.segment<3>(3 * static_cast<Eigen::Index>(entry.vertex));
+        sum += static_cast<Scalar>(entry.weight) * coarse.template segment<3>(3 * static_cast<Eigen::Index>(entry.vertex));
       }
       for (int axis = 0; axis < 3; ++axis)
         if (!fine_fixed[3 * v + static_cast<std::size_t>(axis)]) fine[static_cast<Eigen::Index>(3 * v) + axis] += sum[axis];
@@ -44,21 +50,42 @@ void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine
   });
 }
 
-void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& fine, Vector& coarse) {
+template <typename VectorType>
+void restrict_to_coarse_any(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const VectorType& fine,
+                            VectorType& coarse) {
+  using Scalar = typename VectorType::Scalar;
   const auto vertices = static_cast<std::size_t>(p.coarse_count());
   coarse.resize(static_cast<Eigen::Index>(3 * vertices));
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t v = range.begin(); v < range.end(); ++v) {
-      Vec3 sum = Vec3::Zero();
+      Eigen::Matrix<Scalar, 3, 1> sum = Eigen::Matrix<Scalar, 3, 1>::Zero();
       for (int e = p.coarse_start[v]; e < p.coarse_start[v + 1]; ++e) {
         const auto& entry = p.by_coarse[static_cast<std::size_t>(e)];
         const auto f = static_cast<std::size_t>(entry.vertex);
         for (int axis = 0; axis < 3; ++axis)
-          if (!fine_fixed[3 * f + static_cast<std::size_t>(axis)]) sum[axis] += entry.weight * fine[static_cast<Eigen::Index>(3 * f) + axis];
+          if (!fine_fixed[3 * f + static_cast<std::size_t>(axis)])
+            sum[axis] += static_cast<Scalar>(entry.weight) * fine[static_cast<Eigen::Index>(3 * f) + axis];
       }
-      coarse.segment<3>(static_cast<Eigen::Index>(3 * v)) = sum;
+      coarse.template segment<3>(static_cast<Eigen::Index>(3 * v)) = sum;
     }
   });
+}
+
+}  // namespace
+
+void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine) {
+  prolongate_add_any(p, fine_fixed, coarse, fine);
+}
+void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Eigen::VectorXf& coarse,
+                    Eigen::VectorXf& fine) {
+  prolongate_add_any(p, fine_fixed, coarse, fine);
+}
+void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& fine, Vector& coarse) {
+  restrict_to_coarse_any(p, fine_fixed, fine, coarse);
+}
+void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Eigen::VectorXf& fine,
+                        Eigen::VectorXf& coarse) {
+  restrict_to_coarse_any(p, fine_fixed, fine, coarse);
 }
 
 MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options) {
@@ -89,8 +116,10 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     grid = std::move(next.coarse);
     m.levels_.push_back(std::move(coarse));
   }
-  for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l)
+  for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     m.levels_[l].smoother = make_chebyshev_smoother(m.operator_of(l), options.smoother);
+    m.levels_[l].blocks = to_block_sparse<float>(m.operator_of(l));
+  }
 
   m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
   const Eigen::SparseMatrix<double> coarsest(m.operator_of(m.levels_.size() - 1));
@@ -112,11 +141,24 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
   return m;
 }
 
+void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>& a) {
+  if (levels_.size() < 2) return;  // a single level: the (older) factorization preconditions
+  MultigridLevel& fine = levels_[0];
+  if (a.blocks() != fine.blocks.blocks() || a.block_rows() != fine.blocks.block_rows())
+    throw InputError("multigrid: the refreshed matrix does not have the pattern the levels were built from");
+  fine.smoother.inverse_diagonal = inverse_diagonal_blocks(a);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.values.size(), std::size_t{1} << 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) fine.blocks.values[i] = static_cast<float>(a.values[i]);
+                    });
+}
+
 void MultigridPreconditioner::cycle(std::size_t l) const {
   const MultigridLevel& level = levels_[l];
-  const SparseMatrix& a = operator_of(l);
+  const BlockSparseMatrix<float>& a = level.blocks;
   if (l + 1 == levels_.size()) {
-    level.solution = coarsest_->ldlt.solve(level.rhs);
+    const Vector rhs = level.rhs.cast<double>();
+    level.solution = coarsest_->ldlt.solve(rhs).cast<float>();
     if (!level.solution.allFinite()) level.solution.setZero();
     return;
   }
@@ -130,9 +172,9 @@ void MultigridPreconditioner::cycle(std::size_t l) const {
 }
 
 void MultigridPreconditioner::apply(const Vector& r, Vector& z) const {
-  levels_[0].rhs = r;
+  levels_[0].rhs = r.cast<float>();
   cycle(0);
-  z = levels_[0].solution;
+  z = levels_[0].solution.cast<double>();
 }
 
 }  // namespace cleave

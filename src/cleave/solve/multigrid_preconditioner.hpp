@@ -5,6 +5,7 @@
 // separated on every level; coarse operators are Galerkin products P^T A P with fixed dofs left
 // out of P (galerkin_operator.hpp); Chebyshev / block-Jacobi smoothing before and after the
 // coarse correction (chebyshev_smoother.hpp); a sparse Cholesky (LDL^T) solve on the coarsest level.
+// The cycle runs in single precision on block CSR copies of the operators (block_sparse_matrix.hpp).
 //
 //   MultigridPreconditioner m = build_multigrid(a, volume);   // a: 3 n_v x 3 n_v on volume's vertices
 //   m.apply(r, z);                                            // z = one V-cycle on A z = r from z = 0
@@ -16,6 +17,7 @@
 #include <memory>
 #include <vector>
 
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/chebyshev_smoother.hpp"
 #include "cleave/solve/coarsen_grid_level.hpp"
 #include "cleave/solve/conjugate_gradient.hpp"
@@ -27,15 +29,24 @@ struct MultigridOptions {
   double min_coarsening_ratio = 0.85;    ///< stop when a level keeps more than this share of dofs
   int max_levels = 12;
   ChebyshevOptions smoother;
+  /// update_values() keeps the coarse levels of an older matrix for at most this many updates
+  /// (only the fine level's matrix and block diagonal follow every update) ...
+  int max_stale_updates = 16;
+  /// ... and rebuilds them sooner when a solve needs more than this factor (plus 2) times the
+  /// iterations of the first solve after the last rebuild.
+  double stale_iteration_growth = 1.3;
 };
 
 /// One level: its operator, smoother, and the prolongation from the next coarser level.
+/// The cycle runs in single precision on `blocks` (block CSR, half the bytes of scalar CSR in
+/// double); the outer CG (double) absorbs the rounding.
 struct MultigridLevel {
   SparseMatrix matrix;              ///< coarse levels only; level 0 uses the referenced fine matrix
+  BlockSparseMatrix<float> blocks;  ///< the level's operator in float (all levels but the coarsest)
   std::vector<std::uint8_t> fixed;  ///< per dof: identity row
   ChebyshevSmoother smoother;
   Prolongation from_coarser;        ///< empty on the coarsest level
-  mutable Vector rhs, solution, residual;
+  mutable Eigen::VectorXf rhs, solution, residual;
   mutable ChebyshevWork work;
 };
 
@@ -47,6 +58,12 @@ class MultigridPreconditioner final : public Preconditioner {
   MultigridPreconditioner& operator=(MultigridPreconditioner&&) noexcept;
 
   void apply(const Vector& r, Vector& z) const override;
+
+  /// Gives the fine level's smoother the values of `a` (the matrix built from, as block CSR,
+  /// with new values: same pattern and fixed dofs) and their block diagonal; the coarse levels,
+  /// the smoothers' eigenvalue bounds and the coarsest factorization stay those of the older
+  /// matrix, and so does operator_of(0).
+  void refresh_fine_level(const BlockSparseMatrix<double>& a);
 
   /// Level 0 is the fine level; the last level is solved directly.
   const std::vector<MultigridLevel>& levels() const { return levels_; }
@@ -68,7 +85,11 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
 
 /// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
 void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
+void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Eigen::VectorXf& coarse,
+                    Eigen::VectorXf& fine);
 /// coarse = P^T fine, leaving fixed fine dofs out.
 void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& fine, Vector& coarse);
+void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Eigen::VectorXf& fine,
+                        Eigen::VectorXf& coarse);
 
 }  // namespace cleave

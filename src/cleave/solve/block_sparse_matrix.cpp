@@ -1,0 +1,145 @@
+#include "cleave/solve/block_sparse_matrix.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+namespace cleave {
+namespace {
+
+/// Block rows per task: a few hundred KB of matrix, so scheduling costs nothing.
+constexpr Eigen::Index kBlockRowsPerTask = 512;
+
+template <typename Fn>
+void for_each_block_row(Eigen::Index rows, const Fn& fn) {
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, rows, kBlockRowsPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    for (Eigen::Index v = r.begin(); v < r.end(); ++v) fn(v);
+  });
+}
+
+/// Copies the CSR rows 3v..3v+2 into the (already patterned) blocks of block row v.
+template <typename Scalar>
+void fill_block_row(const SparseMatrix& a, Eigen::Index v, BlockSparseMatrix<Scalar>& b) {
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  const double* values = a.valuePtr();
+  const std::int32_t first = b.row_start[static_cast<std::size_t>(v)];
+  const std::int32_t last = b.row_start[static_cast<std::size_t>(v) + 1];
+  std::fill(b.values.begin() + 9 * first, b.values.begin() + 9 * last, Scalar{0});
+  for (int i = 0; i < 3; ++i) {
+    std::int32_t block = first;
+    for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) {
+      const std::int32_t col = inner[k];
+      while (b.column[static_cast<std::size_t>(block)] != col / 3) ++block;
+      b.values[9 * static_cast<std::size_t>(block) + 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(col % 3)] =
+          static_cast<Scalar>(values[k]);
+    }
+  }
+}
+
+}  // namespace
+
+template <typename Scalar>
+BlockSparseMatrix<Scalar> to_block_sparse(const SparseMatrix& a) {
+  BlockSparseMatrix<Scalar> b;
+  const Eigen::Index n = a.rows() / 3;
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  std::vector<std::vector<std::int32_t>> columns(static_cast<std::size_t>(n));
+  for_each_block_row(n, [&](Eigen::Index v) {
+    auto& c = columns[static_cast<std::size_t>(v)];
+    for (int i = 0; i < 3; ++i)
+      for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) c.push_back(inner[k] / 3);
+    std::sort(c.begin(), c.end());
+    c.erase(std::unique(c.begin(), c.end()), c.end());
+  });
+  b.row_start.assign(static_cast<std::size_t>(n) + 1, 0);
+  for (Eigen::Index v = 0; v < n; ++v)
+    b.row_start[static_cast<std::size_t>(v) + 1] =
+        b.row_start[static_cast<std::size_t>(v)] + static_cast<std::int32_t>(columns[static_cast<std::size_t>(v)].size());
+  b.column.resize(static_cast<std::size_t>(b.row_start.back()));
+  b.values.resize(9 * b.column.size());
+  for_each_block_row(n, [&](Eigen::Index v) {
+    std::copy(columns[static_cast<std::size_t>(v)].begin(), columns[static_cast<std::size_t>(v)].end(),
+              b.column.begin() + b.row_start[static_cast<std::size_t>(v)]);
+    fill_block_row(a, v, b);
+  });
+  return b;
+}
+
+template <typename Scalar>
+void refresh_block_values(const SparseMatrix& a, BlockSparseMatrix<Scalar>& b) {
+  for_each_block_row(b.block_rows(), [&](Eigen::Index v) { fill_block_row(a, v, b); });
+}
+
+namespace {
+
+/// sum over the blocks of row v of A_vw x_w.
+template <typename Scalar>
+inline Eigen::Matrix<Scalar, 3, 1> row_product(const BlockSparseMatrix<Scalar>& a, const Scalar* x, Eigen::Index v) {
+  Scalar s0 = 0, s1 = 0, s2 = 0;
+  const std::int32_t last = a.row_start[static_cast<std::size_t>(v) + 1];
+  const Scalar* m = a.values.data() + 9 * static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v)]);
+  for (std::int32_t k = a.row_start[static_cast<std::size_t>(v)]; k < last; ++k, m += 9) {
+    const Scalar* xw = x + 3 * static_cast<std::size_t>(a.column[static_cast<std::size_t>(k)]);
+    const Scalar x0 = xw[0], x1 = xw[1], x2 = xw[2];
+    s0 += m[0] * x0 + m[1] * x1 + m[2] * x2;
+    s1 += m[3] * x0 + m[4] * x1 + m[5] * x2;
+    s2 += m[6] * x0 + m[7] * x1 + m[8] * x2;
+  }
+  return {s0, s1, s2};
+}
+
+}  // namespace
+
+template <typename Scalar>
+void multiply(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatrix<Scalar>::VectorType& x,
+              typename BlockSparseMatrix<Scalar>::VectorType& y) {
+  y.resize(a.rows());
+  const Scalar* xp = x.data();
+  Scalar* yp = y.data();
+  for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
+    const auto s = row_product(a, xp, v);
+    yp[3 * v] = s[0];
+    yp[3 * v + 1] = s[1];
+    yp[3 * v + 2] = s[2];
+  });
+}
+
+template <typename Scalar>
+void residual(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatrix<Scalar>::VectorType& b,
+              const typename BlockSparseMatrix<Scalar>::VectorType& x, typename BlockSparseMatrix<Scalar>::VectorType& r) {
+  r.resize(a.rows());
+  const Scalar* xp = x.data();
+  const Scalar* bp = b.data();
+  Scalar* rp = r.data();
+  for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
+    const auto s = row_product(a, xp, v);
+    rp[3 * v] = bp[3 * v] - s[0];
+    rp[3 * v + 1] = bp[3 * v + 1] - s[1];
+    rp[3 * v + 2] = bp[3 * v + 2] - s[2];
+  });
+}
+
+void jacobi_residual(const BlockSparseMatrix<float>& a, const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b,
+                     const Eigen::VectorXf& x, Eigen::VectorXf& z) {
+  z.resize(a.rows());
+  const float* xp = x.data();
+  for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
+    const Eigen::Vector3f r = b.segment<3>(3 * v) - row_product(a, xp, v);
+    z.segment<3>(3 * v) = inverse_diagonal[static_cast<std::size_t>(v)] * r;
+  });
+}
+
+template BlockSparseMatrix<float> to_block_sparse<float>(const SparseMatrix&);
+template BlockSparseMatrix<double> to_block_sparse<double>(const SparseMatrix&);
+template void refresh_block_values<float>(const SparseMatrix&, BlockSparseMatrix<float>&);
+template void refresh_block_values<double>(const SparseMatrix&, BlockSparseMatrix<double>&);
+template void multiply<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, Eigen::VectorXf&);
+template void multiply<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, Eigen::VectorXd&);
+template void residual<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, const Eigen::VectorXf&, Eigen::VectorXf&);
+template void residual<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                               Eigen::VectorXd&);
+
+}  // namespace cleave

@@ -1,0 +1,62 @@
+// Dynamic step timings on the paper's 44,000-cell tube (Table 1), held at one end, under a
+// sideways load. A benchmark, not a test: DISABLED_ so that it runs only on request:
+//   cleave_test_fem --gtest_also_run_disabled_tests --gtest_filter='*DynamicsBenchmark*'
+// Environment: CLEAVE_BENCH_SOLVER (multigrid, eigen-cg, cholmod; default multigrid),
+// CLEAVE_BENCH_STEPS (default 20). Prints per-step times and iterations; asserts only that every
+// step converged.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <ctime>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "cleave/fem/dynamics.hpp"
+#include "cleave/shapes/builtin_shapes.hpp"
+
+namespace cleave {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(42, 42, 51);
+  Material m;
+  m.youngs_modulus_kPa = 3.0;
+  m.poisson_ratio = 0.45;
+  const TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+  const LinkedVolume& volume = model.volume;
+  DynamicsSettings settings;
+  const char* solver = std::getenv("CLEAVE_BENCH_SOLVER");
+  if (solver != nullptr) settings.solver = solver_kind_from_name(solver);
+  const char* steps_text = std::getenv("CLEAVE_BENCH_STEPS");
+  const int steps = steps_text != nullptr ? std::atoi(steps_text) : 20;
+  settings.mass_damping_per_s = 2.0;
+  settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
+  const double z0 = volume.grid().origin_mm.z();
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    if (volume.vertex_position_mm(v).z() < z0 + 1e-9) settings.fixed_vertices.push_back(v);
+    settings.external_force_mN[3 * v] = 1e-3;
+  }
+  Dynamics sim(model, {}, settings);
+  std::vector<double> ms;
+  for (int i = 0; i < steps; ++i) {
+    const auto t = Clock::now();
+    const std::clock_t cpu = std::clock();
+    const SolveReport r = sim.step(1.0 / 60.0);
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+    const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
+    std::printf("step %2d  %8.1f ms wall  %8.1f ms cpu (all threads)  %3d it  residual %.1e\n", i, ms.back(), cpu_ms,
+                r.iterations, r.relative_residual);
+    std::fflush(stdout);
+    EXPECT_TRUE(r.converged);
+  }
+  std::sort(ms.begin(), ms.end());
+  std::printf("%s: %d cells, median step %.1f ms\n", std::string(sim.solver_name()).c_str(), volume.cell_count(), ms[ms.size() / 2]);
+}
+
+}  // namespace
+}  // namespace cleave
