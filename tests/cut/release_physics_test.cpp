@@ -27,11 +27,11 @@ constexpr double kCrossKPa = 10.0;   // and across them
 constexpr double kYoungKPa = 80.0;
 constexpr double kPoisson = 0.4;
 
-/// The multigrid-preconditioned CG solver (relative residual 1e-8): the same openings as CHOLMOD
-/// to the digits reported here, several times faster on these models (fem/solver_agreement_test).
-StaticOptions held(const LinkedVolume& volume, std::vector<VertexId> fixed) {
+/// By default the multigrid-preconditioned CG solver (relative residual 1e-8): the same openings
+/// as CHOLMOD to the digits reported here, several times faster on these models.
+StaticOptions held(const LinkedVolume& volume, std::vector<VertexId> fixed, SolverKind solver = SolverKind::multigrid_cg) {
   StaticOptions o;
-  o.solver = SolverKind::multigrid_cg;
+  o.solver = solver;
   o.fixed_vertices = std::move(fixed);
   (void)volume;
   return o;
@@ -128,8 +128,11 @@ TEST(ReleasePhysics, Fig10TubeIncisionsRoundAboveEllipticalBelow) {
     if (p.z() <= 0 || p.z() >= length || std::hypot(p.x() - axis_point.x(), p.y() - axis_point.y()) <= kInnerWallMm)
       ends.push_back(v);
   }
+  // Eigen's IC-preconditioned CG: since the single-precision V-cycle (solve, 9002139) the multigrid
+  // CG stalls on this tube (relative residual 0.0175 after 65 iterations).
+  constexpr SolverKind kTubeSolver = SolverKind::eigen_cg;
   const LinkedVolume uncut = model.volume;
-  const StaticResult before = solve_static(model, stress, held(model.volume, ends));
+  const StaticResult before = solve_static(model, stress, held(model.volume, ends, kTubeSolver));
 
   constexpr int kAround = 6;
   constexpr double kRadiusMm = 7.0, kDepthMm = 6.0;
@@ -142,7 +145,7 @@ TEST(ReleasePhysics, Fig10TubeIncisionsRoundAboveEllipticalBelow) {
   const BodySurface surface(model);
   const CutPlan plan = plan_cuts(surface, r);
   apply_cut_plan(model.volume, plan);
-  const StaticResult after = solve_static(model, stress, held(model.volume, ends));
+  const StaticResult after = solve_static(model, stress, held(model.volume, ends, kTubeSolver));
   const std::vector<Vec3> u = released_by_cuts(model.volume, after.displacement_mm, uncut, before.displacement_mm);
   for (std::size_t i = 0; i < plan.incisions.size(); ++i) {
     const bool upper = i < kAround;

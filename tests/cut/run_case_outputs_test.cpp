@@ -15,6 +15,8 @@
 
 #include "cleave/io/case_file.hpp"
 #include "cleave/io/ply_reader.hpp"
+#include "cleave/pipeline/demo_case.hpp"
+#include "cleave/shapes/builtin_shapes.hpp"
 #include "cleave/pipeline/run_case.hpp"
 
 namespace cleave {
@@ -141,6 +143,30 @@ TEST(RunCaseOutputs, DynamicRunWritesAParaViewSeriesOfFrames) {
   ASSERT_EQ(times.size(), 5u);
   for (std::size_t k = 0; k < times.size(); ++k) EXPECT_NEAR(times[k], 0.05 * static_cast<double>(k), 1e-9);
   EXPECT_GT(last_max_u, 0.1);  // the wound has begun to open by t = 0.2 s
+}
+
+TEST(RunCaseOutputs, DemoIncisionsFollowLangersLinesAndTheCutAcrossGapesWider) {
+  ShapeResolution resolution;
+  resolution.cell_size_mm = kDemoCellSizeMm;
+  const TissueModel abdomen = make_tissue_model("abdomen", make_builtin_shape("abdomen", resolution));
+  const auto dir = fresh_dir("demo");
+  const json summary = run(abdomen_demo_case(abdomen, DemoStress::designed), dir);
+  int anisotropic = 0;
+  for (const json& i : summary["incisions"]) {
+    EXPECT_GT(i["opening_mm"].get<double>(), 0.0) << i.dump();
+    if (i.value("eigenvalue_ratio", 0.0) < 1.5) continue;
+    ++anisotropic;
+    EXPECT_LT(i["langer_angle_deg"].get<double>(), 10.0) << i.dump();
+    EXPECT_GT(i["outer"]["axis_ratio"].get<double>(), 1.05) << i.dump();
+  }
+  EXPECT_GE(anisotropic, 10);
+  const json& cuts = summary["cuts"];
+  ASSERT_EQ(cuts.size(), 3u);
+  const double across = cuts[0]["max_width_mm"].get<double>(), along = cuts[1]["max_width_mm"].get<double>();
+  EXPECT_GE(across, 5.0);  // paper section 7: 5 to 20 mm
+  EXPECT_LE(across, 20.0);
+  EXPECT_GE(across, 1.5 * along);
+  EXPECT_LT(cuts[2]["skin_area_change_percent"].get<double>(), -5.0);  // the flap shrinks
 }
 
 }  // namespace
