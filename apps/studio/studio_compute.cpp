@@ -10,8 +10,13 @@
 #include "cleave/io/ply_writer.hpp"
 #include "cleave/io/vtu_writer.hpp"
 #include "cleave/cut/place_incisions.hpp"
+#include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/solve_static.hpp"
+#include "cleave/stress/equilibrium_operator.hpp"
+#include "cleave/stress/stroke_constraints.hpp"
+#include "cleave/viz/cut_face_colouring.hpp"
 #include "cleave/viz/incision_ellipses.hpp"
+#include "cleave/viz/streamlines.hpp"
 #include "cleave/viz/wound_measures.hpp"
 
 namespace cleave::studio {
@@ -24,16 +29,94 @@ constexpr double kPreviewRadiusCells = 2.5;   ///< incision radius
 constexpr double kPreviewDepthCells = 2.0;    ///< incision depth
 constexpr double kPreviewSpacingCells = 9.0;  ///< least distance between centres (> diameter + 1 cell)
 
+constexpr double kRounding = 1e-3;       ///< mm, kPa: result fields
+constexpr double kFrameRounding = 1e-2;  ///< mm: positions in frames and streamlines (0.01 mm)
+
+// The wound opening after a cut: Newmark steps streamed to the page, one frame per step.
+constexpr int kOpeningFrames = 12;
+constexpr double kOpeningStep_s = 0.02;            ///< 12 steps: the first 0.24 s of the opening (Newmark is stable at any step)
+constexpr double kOpeningDamping_per_s = 20.0;     ///< mass damping, as examples/plate_flap_dynamic.json
+
+constexpr int kStreamlineSeedStride = 4;  ///< cells between seeds
+constexpr int kStreamlineMaxSteps = 40;   ///< half cells per direction
+
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
-/// Rounds to 1e-3 mm / kPa: the page does not need more and the messages stay small.
-double rounded(double v) { return std::round(v * 1000.0) / 1000.0; }
 
-nlohmann::json float_array(const std::vector<float>& values) {
+/// Rounds to `step` (mm, kPa): the page does not need more and the messages stay small.
+double rounded_to(double v, double step) { return std::round(v / step) * step; }
+
+nlohmann::json float_array(const std::vector<float>& values, double step = kRounding) {
   nlohmann::json a = nlohmann::json::array();
   a.get_ref<nlohmann::json::array_t&>().reserve(values.size());
-  for (float v : values) a.push_back(rounded(static_cast<double>(v)));
+  for (float v : values) a.push_back(rounded_to(static_cast<double>(v), step));
   return a;
+}
+
+/// Triangle indices of `surface` without the hidden plugs of the round incisions.
+std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const CutPlan& plan) {
+  std::vector<std::uint8_t> hidden(surface.quad_of_face.size() / 6, 0);
+  for (CellId c : plan.hidden_cells()) hidden[static_cast<std::size_t>(c)] = 1;
+  std::vector<std::uint32_t> triangles;
+  triangles.reserve(3 * surface.triangles.size());
+  for (std::int32_t i = 0; i < surface.triangle_count(); ++i) {
+    if (hidden[static_cast<std::size_t>(surface.triangle_cell(i))]) continue;
+    for (SurfaceVertexId v : surface.triangles[static_cast<std::size_t>(i)]) triangles.push_back(static_cast<std::uint32_t>(v));
+  }
+  return triangles;
+}
+
+/// The equilibrium residual |T sigma| / h^2 (kPa) at each surface vertex: the force left at the
+/// uncut model's vertex of the surface vertex's grid corner, as a stress.
+std::vector<float> residual_per_surface_vertex(const LinkedVolume& volume, const SparseMatrix& divergence,
+                                               std::span<const Vec6> stress_kPa, const RenderSurface& surface) {
+  const Vector force = divergence * flatten_stress(stress_kPa);
+  const double h = volume.grid().cell_size_mm;
+  std::vector<float> out(static_cast<std::size_t>(surface.vertex_count()), 0.0f);
+  for (std::size_t v = 0; v < out.size(); ++v) {
+    for (VertexId w : volume.cell_vertices(surface.cell[v])) {
+      if (volume.vertex_grid_corner(w) != surface.grid_corner[v]) continue;
+      out[v] = static_cast<float>(force.segment<3>(3 * static_cast<Eigen::Index>(w)).norm() / (h * h));
+      break;
+    }
+  }
+  return out;
+}
+
+struct CutFaceValues {
+  bool any = false;
+  std::vector<float> depth;         ///< per surface vertex: 0 skin .. 1 inner layer; -1 off the cut faces
+  std::vector<float> traction_kPa;  ///< per surface vertex: released traction; -1 off the cut faces
+};
+
+/// Per surface vertex, the mean over the cut faces around it of colour_cut_faces' values.
+CutFaceValues cut_face_values(const BodySurface& body, const TissueModel& cut_model, const RenderSurface& surface,
+                              std::span<const Vec6> stress_kPa) {
+  CutFaceValues out;
+  const std::vector<CellFace> faces = cut_faces(cut_model.volume);
+  if (faces.empty()) return out;
+  const CutFaceColours colours = colour_cut_faces(body, faces, stress_kPa);
+  const auto n = static_cast<std::size_t>(surface.vertex_count());
+  std::vector<double> depth(n, 0.0), traction(n, 0.0);
+  std::vector<int> count(n, 0);
+  for (std::size_t i = 0; i < faces.size(); ++i) {
+    const std::int32_t q = surface.quad_of_face[6 * static_cast<std::size_t>(faces[i].cell) + static_cast<std::size_t>(faces[i].face)];
+    if (q == kNone) continue;
+    for (SurfaceVertexId v : surface.quads[static_cast<std::size_t>(q)].vertices) {
+      depth[static_cast<std::size_t>(v)] += colours.depth[i];
+      traction[static_cast<std::size_t>(v)] += colours.released_traction_kPa[i];
+      ++count[static_cast<std::size_t>(v)];
+    }
+  }
+  out.depth.assign(n, -1.0f);
+  out.traction_kPa.assign(n, -1.0f);
+  for (std::size_t v = 0; v < n; ++v) {
+    if (count[v] == 0) continue;
+    out.any = true;
+    out.depth[v] = static_cast<float>(depth[v] / count[v]);
+    out.traction_kPa[v] = static_cast<float>(traction[v] / count[v]);
+  }
+  return out;
 }
 
 }  // namespace
@@ -81,6 +164,120 @@ void StudioCompute::prepare(const FieldWorker::Context& ctx) {
   }
 }
 
+const DesignResult* StudioCompute::design_fields(const DesignState& design, nlohmann::json& message,
+                                                 nlohmann::json& timings) {
+  const TissueModel& model = session_.model();
+  StressDesign stress_design;
+  for (const Stroke& s : design.strokes) stress_design.strokes.push_back({s.points_mm, StrokePlacement::surface});
+  for (const ControlPoint& p : design.control_points)
+    stress_design.control_points.push_back({p.position_mm, p.langer_kPa, p.cross_kPa});
+  if (stress_design.strokes.empty() && stress_design.control_points.empty()) {
+    designer_.reset();
+    return nullptr;
+  }
+  if (!stress_design.control_points.empty()) {
+    // Directions and magnitudes. The studio keeps the least-squares design with its equilibrium
+    // term (eq. 9) and skips the exact equilibration (one elastic solve per edit, seconds on the
+    // abdomen): the page shows the remaining residual ("Equilibrium residual" display).
+    stress_design.equilibration = Equilibration::none;
+    try {
+      if (!designer_) designer_ = std::make_unique<StressDesigner>(model, stress_design);
+      else designer_->set_design(stress_design);
+      const DesignResult& r = designer_->result();
+      timings["directions"] = 1000.0 * r.timings.directions_s;
+      timings["eigenvalues"] = 1000.0 * r.timings.eigenvalues_s;
+      message["equilibrium_residual"] = {{"designed", r.residual_designed}, {"final", r.residual_final}};
+      stress_kPa_ = r.stress_kPa;
+      return &r;
+    } catch (const InputError& err) {
+      message["design_error"] = err.what();  // e.g. a control point off the surface: directions still shown
+      designer_.reset();
+    } catch (const ComputeError& err) {
+      message["design_error"] = err.what();
+      designer_.reset();
+    }
+  } else {
+    designer_.reset();
+  }
+  // Directions only (no control point yet, or the magnitudes failed): the direction step needs
+  // no eigenvalues (paper section 6.3).
+  const auto t = Clock::now();
+  try {
+    if (!langer_only_) {
+      langer_only_ = std::make_unique<LineFieldInterpolator>(model.volume, stress_design.weights);
+      LineFieldInterpolator normal_interp(model.volume, stress_design.weights);
+      normal_tensors_ = normal_interp.interpolate(surface_normal_targets(model));
+    }
+    const double tolerance_mm = stress_design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
+    const std::vector<LineTarget> targets = stroke_line_targets(model, stress_design.strokes, tolerance_mm);
+    directions_only_ = DesignResult{};
+    directions_only_.frames = direction_frames(langer_only_->interpolate(targets), normal_tensors_);
+  } catch (const InputError& err) {
+    message["design_error"] = err.what();
+    return nullptr;
+  }
+  timings["directions"] = ms_since(t);
+  if (!message.contains("design_error") && stress_design.control_points.empty())
+    message["eigenvalue_note"] = "directions only: place a control point (Magnitude tool) to set the eigenvalues";
+  return &directions_only_;
+}
+
+bool StudioCompute::cut_model(const CutRequests& requests, const std::string& key, nlohmann::json& message) {
+  if (preview_model_ && key == cut_key_) return false;
+  try {
+    plan_ = plan_cuts(*body_surface_, requests);
+  } catch (const InputError& e) {
+    message["cut_error"] = e.what();
+    CutRequests incisions_only;
+    incisions_only.incisions = requests.incisions;
+    plan_ = plan_cuts(*body_surface_, incisions_only);
+  }
+  preview_model_ = std::make_shared<TissueModel>(session_.model());
+  apply_cut_plan(preview_model_->volume, plan_);
+  preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
+  // Measurements sample the margins on the cut body's own surface (its split vertices).
+  cut_body_surface_ = plan_.incisions.empty() ? nullptr : std::make_unique<BodySurface>(*preview_model_);
+  cut_key_ = key;
+  return true;
+}
+
+void StudioCompute::stream_opening(const DesignState& design, std::uint64_t generation, const FieldWorker::Context& ctx,
+                                   nlohmann::json& timings) {
+  const auto t0 = Clock::now();
+  const RenderSurface& surface = *preview_surface_;
+  DynamicsSettings settings;
+  settings.mass_damping_per_s = kOpeningDamping_per_s;
+  settings.solver = SolverKind::cholmod;
+  Dynamics sim(*preview_model_, stress_kPa_, settings);
+  std::vector<std::uint32_t> triangles = visible_triangles(surface, plan_);
+  double step_ms = 0;
+  for (int i = 0; i <= kOpeningFrames; ++i) {
+    if (ctx.superseded()) return;
+    const auto ts = Clock::now();
+    if (i > 0) sim.step(kOpeningStep_s);
+    const std::vector<Vec3> u = sim.displacement_mm();
+    const std::vector<Vec3> x = deformed_positions(surface, preview_model_->volume, u);
+    nlohmann::json frame = {{"type", "frame"}, {"generation", generation}, {"index", i}, {"frames", kOpeningFrames},
+                            {"time_s", sim.time_s()}};
+    std::vector<float> positions;
+    positions.reserve(3 * x.size());
+    for (const Vec3& p : x)
+      for (int a = 0; a < 3; ++a) positions.push_back(static_cast<float>(p[a]));
+    frame["positions_mm"] = float_array(positions, kFrameRounding);
+    if (i == 0) frame["triangles"] = triangles;
+    std::size_t scalpel = 0;
+    for (const Cut& c : design.cuts) {
+      if (c.kind != CutKind::scalpel || scalpel >= plan_.scalpel_paths.size()) continue;
+      frame["width_mm"] = scalpel_wound_width(preview_model_->volume, u, plan_.scalpel_paths[scalpel++]).max_mm;
+    }
+    if (i > 0) step_ms += ms_since(ts);
+    frame["step_ms"] = i > 0 ? step_ms / i : 0.0;
+    send_(frame.dump());
+  }
+  timings["opening"] = ms_since(t0);
+  timings["frame"] = step_ms / kOpeningFrames;
+}
+
 nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx) {
   const auto t0 = Clock::now();
   nlohmann::json timings = nlohmann::json::object();
@@ -93,60 +290,43 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
                             {"design_items", design.strokes.size() + design.control_points.size() + design.cuts.size()}};
 
   // 1. The residual stress design (stress/stress_designer.hpp), incremental between edits.
-  StressDesign stress_design;
-  for (const Stroke& s : design.strokes) stress_design.strokes.push_back({s.points_mm, StrokePlacement::surface});
-  for (const ControlPoint& p : design.control_points)
-    stress_design.control_points.push_back({p.position_mm, p.langer_kPa, p.cross_kPa});
-  const bool has_design = !stress_design.strokes.empty() && !stress_design.control_points.empty();
-  const DesignResult* fields = nullptr;
+  report(ctx.progress, "direction and eigenvalue fields", 0.1);
   stress_kPa_.clear();
-  if (!stress_design.strokes.empty() || !stress_design.control_points.empty()) {
-    report(ctx.progress, "direction and eigenvalue fields", 0.1);
-    try {
-      if (!designer_) designer_ = std::make_unique<StressDesigner>(model, stress_design);
-      else designer_->set_design(stress_design);
-      fields = &designer_->result();
-      timings["directions"] = 1000.0 * fields->timings.directions_s;
-      timings["eigenvalues"] = 1000.0 * fields->timings.eigenvalues_s;
-      timings["equilibration"] = 1000.0 * fields->timings.equilibration_s;
-      if (has_design) stress_kPa_ = fields->stress_kPa;
-      message["equilibrium_residual"] = {{"designed", fields->residual_designed}, {"final", fields->residual_final}};
-    } catch (const InputError& e) {
-      message["design_error"] = e.what();
-      designer_.reset();
-    }
-  }
+  const DesignResult* fields = design_fields(design, message, timings);
+  const bool has_stress = !stress_kPa_.empty();
   if (ctx.superseded()) return nullptr;
 
-  // 2. The cuts: the round-incision preview and the user's cuts, on a copy of the model.
+  // 2. The cuts: the round-incision preview and the user's cuts, on a copy of the model; the
+  // cut model and its render surface are kept while the cuts do not change.
   auto t = Clock::now();
   report(ctx.progress, "incisions and cuts", 0.4);
   CutRequests requests;
-  if (has_design) requests.incisions = preview_incisions_;
+  if (has_stress) requests.incisions = preview_incisions_;
   for (const Cut& c : design.cuts) {
     if (c.kind == CutKind::flap) requests.flaps.push_back({c.path_mm, c.depth_mm, FlapShape::u_shaped});
     else requests.scalpel_cuts.push_back({c.path_mm, c.depth_mm, 0.0});
   }
-  CutPlan plan;
-  try {
-    plan = plan_cuts(*body_surface_, requests);
-  } catch (const InputError& e) {
-    message["cut_error"] = e.what();
-    requests.scalpel_cuts.clear();
-    requests.flaps.clear();
-    plan = plan_cuts(*body_surface_, requests);
-  }
-  preview_model_ = std::make_shared<TissueModel>(model);
-  apply_cut_plan(preview_model_->volume, plan);
-  preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
+  nlohmann::json cuts_json = nlohmann::json::array();
+  for (const Cut& c : design.cuts) cuts_json.push_back({to_string(c.kind), c.depth_mm, c.path_mm.size(), c.path_mm.front().x(),
+                                                        c.path_mm.back().x(), c.path_mm.back().y(), c.path_mm.back().z()});
+  const std::string previous_key = cut_key_;
+  const std::string key = fmt::format("{}|{}", has_stress ? 1 : 0, cuts_json.dump());
+  const bool recut = cut_model(requests, key, message);
   timings["cuts"] = ms_since(t);
   if (ctx.superseded()) return nullptr;
+  const bool user_cuts_changed = recut && previous_key.substr(previous_key.find('|') + 1) != key.substr(key.find('|') + 1);
 
-  // 3. The wounds open: statics with the residual stress on the cut body.
+  // 3. The wounds open: the opening streamed frame by frame when the user's cuts changed, then
+  // the equilibrium by statics with the residual stress on the cut body.
   displacement_mm_.clear();
-  if (!stress_kPa_.empty() && !requests.empty()) {
+  if (has_stress && !requests.empty()) {
+    if (user_cuts_changed && !design.cuts.empty()) {
+      report(ctx.progress, "opening the wound", 0.5);
+      stream_opening(design, ctx.generation, ctx, timings);
+      if (ctx.superseded()) return nullptr;
+    }
     t = Clock::now();
-    report(ctx.progress, "opening the incisions", 0.6);
+    report(ctx.progress, "opening the incisions", 0.7);
     StaticOptions options;
     options.solver = SolverKind::cholmod;
     const StaticResult r = solve_static(*preview_model_, stress_kPa_, options);
@@ -157,59 +337,73 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
 
   // 4. What the page shows, per surface vertex.
   t = Clock::now();
+  report(ctx.progress, "surface", 0.9);
   const RenderSurface& surface = *preview_surface_;
   const std::vector<Vec3> x = deformed_positions(surface, preview_model_->volume, displacement_mm_);
-  const std::vector<CellId> hidden = plan.hidden_cells();
-  std::vector<std::uint8_t> is_hidden(static_cast<std::size_t>(model.volume.cell_count()), 0);
-  for (CellId c : hidden) is_hidden[static_cast<std::size_t>(c)] = 1;
-  std::vector<float> positions, direction, langer, cross, depth;
+  std::vector<float> positions, direction, langer, cross, moved;
   positions.reserve(3 * x.size());
   for (std::size_t v = 0; v < x.size(); ++v) {
     for (int a = 0; a < 3; ++a) positions.push_back(static_cast<float>(x[v][a]));
-    if (fields) {
-      const CellId c = surface.cell[v];
-      const DirectionFrame& f = fields->frames[static_cast<std::size_t>(c)];
-      for (int a = 0; a < 3; ++a) direction.push_back(static_cast<float>(f.langer[a]));
-      langer.push_back(static_cast<float>(fields->eigenvalues_kPa[static_cast<std::size_t>(c)][0]));
-      cross.push_back(static_cast<float>(fields->eigenvalues_kPa[static_cast<std::size_t>(c)][1]));
-    }
-    depth.push_back(static_cast<float>((surface.reference_mm[v] - x[v]).norm()));
+    moved.push_back(static_cast<float>((surface.reference_mm[v] - x[v]).norm()));
+    if (!fields) continue;
+    const auto c = static_cast<std::size_t>(surface.cell[v]);
+    for (int a = 0; a < 3; ++a) direction.push_back(static_cast<float>(fields->frames[c].langer[a]));
+    if (fields->eigenvalues_kPa.empty()) continue;
+    langer.push_back(static_cast<float>(fields->eigenvalues_kPa[c][0]));
+    cross.push_back(static_cast<float>(fields->eigenvalues_kPa[c][1]));
   }
-  std::vector<std::uint32_t> triangles;
-  triangles.reserve(3 * surface.triangles.size());
-  for (std::int32_t i = 0; i < surface.triangle_count(); ++i) {
-    if (is_hidden[static_cast<std::size_t>(surface.triangle_cell(i))]) continue;
-    for (SurfaceVertexId v : surface.triangles[static_cast<std::size_t>(i)]) triangles.push_back(static_cast<std::uint32_t>(v));
-  }
-  message["surface"] = {{"positions_mm", float_array(positions)}, {"triangles", triangles}};
+  message["surface"] = {{"positions_mm", float_array(positions)}, {"triangles", visible_triangles(surface, plan_)}};
   {
     ExportSnapshot snapshot{preview_model_, displacement_mm_, stress_kPa_, make_surface_mesh(surface, x)};
     std::lock_guard lock(latest_mutex_);
     latest_export_ = std::move(snapshot);
   }
   nlohmann::json f = nlohmann::json::object();
-  if (fields) {
-    f["direction"] = float_array(direction);
+  if (fields) f["direction"] = float_array(direction);
+  if (!langer.empty()) {
     f["langer_kPa"] = float_array(langer);
     f["cross_kPa"] = float_array(cross);
   }
-  if (!displacement_mm_.empty()) f["depth"] = float_array(depth);  // displacement magnitude (mm)
+  if (has_stress) {
+    if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
+    f["residual_kPa"] = float_array(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface));
+  }
+  if (!displacement_mm_.empty()) f["displacement_mm"] = float_array(moved);
+  // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).
+  const CutFaceValues cut = cut_face_values(*body_surface_, *preview_model_, surface, stress_kPa_);
+  if (cut.any) {
+    f["cut_depth"] = float_array(cut.depth);
+    f["traction_kPa"] = float_array(cut.traction_kPa);
+  }
   message["fields"] = f;
+  if (fields && !design.strokes.empty()) {
+    StreamlineOptions so;
+    so.seed_stride_cells = kStreamlineSeedStride;
+    so.max_steps = kStreamlineMaxSteps;
+    nlohmann::json lines = nlohmann::json::array();
+    for (const std::vector<Vec3>& line : trace_streamlines(model.volume, fields->frames, so)) {
+      std::vector<float> flat;
+      for (const Vec3& p : line)
+        for (int a = 0; a < 3; ++a) flat.push_back(static_cast<float>(p[a]));
+      lines.push_back(float_array(flat, kFrameRounding));
+    }
+    message["streamlines_mm"] = lines;
+  }
 
   // 5. Measurements: incision openings and wound widths.
   nlohmann::json incisions = nlohmann::json::array();
   nlohmann::json wounds = nlohmann::json::array();
   if (!displacement_mm_.empty()) {
-    for (const IncisionFrame& frame : plan.incisions) {
-      const auto m = measure_incision(*body_surface_, displacement_mm_, frame, std::nullopt);
+    for (const IncisionFrame& frame : plan_.incisions) {
+      const auto m = measure_incision(*cut_body_surface_, displacement_mm_, frame, std::nullopt);
       if (m) incisions.push_back({{"centre_mm", {frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()}},
                                   {"opening_mm", m->opening_mm},
                                   {"gap_mm", m->gap_mm}});
     }
     std::size_t scalpel = 0;
     for (const Cut& c : design.cuts) {
-      if (c.kind != CutKind::scalpel || scalpel >= plan.scalpel_paths.size()) continue;
-      const WoundWidth w = scalpel_wound_width(preview_model_->volume, displacement_mm_, plan.scalpel_paths[scalpel++]);
+      if (c.kind != CutKind::scalpel || scalpel >= plan_.scalpel_paths.size()) continue;
+      const WoundWidth w = scalpel_wound_width(preview_model_->volume, displacement_mm_, plan_.scalpel_paths[scalpel++]);
       wounds.push_back({{"cut", c.id}, {"width_mm", w.max_mm}, {"mean_width_mm", w.mean_mm}});
     }
   }

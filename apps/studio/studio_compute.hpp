@@ -11,6 +11,8 @@
 
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/cut/cut_plan.hpp"
+#include "cleave/solve/linear_solver.hpp"
+#include "cleave/stress/line_field_interpolation.hpp"
 #include "cleave/stress/stress_designer.hpp"
 #include "cleave/surface/render_surface.hpp"
 #include "cleave/surface/surface_mesh.hpp"
@@ -38,15 +40,33 @@ class StudioCompute {
  private:
   nlohmann::json compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx);
   void prepare(const FieldWorker::Context& ctx);
+  /// Stage 1: the design fields. Sets `fields` (null when nothing is designed) and stress_kPa_;
+  /// eigenvalue or equilibration failures go into `message` and leave the directions shown.
+  const DesignResult* design_fields(const DesignState& design, nlohmann::json& message, nlohmann::json& timings);
+  /// Stage 2: the model cut by `requests`; reuses the previous cut model when `key` is unchanged.
+  /// Returns true when the cut model was rebuilt.
+  bool cut_model(const CutRequests& requests, const std::string& key, nlohmann::json& message);
+  /// The wound opening over time (Newmark dynamics on the cut model), one "frame" message per step.
+  void stream_opening(const DesignState& design, std::uint64_t generation, const FieldWorker::Context& ctx,
+                      nlohmann::json& timings);
 
   // Worker-thread state (only the worker touches these).
   std::unique_ptr<BodySurface> body_surface_;         ///< of the uncut model
   std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
   std::unique_ptr<StressDesigner> designer_;
+  /// Directions without magnitudes (strokes but no control point yet): the Langer interpolation
+  /// and the surface normal tensors, built on first use.
+  std::unique_ptr<LineFieldInterpolator> langer_only_;
+  std::vector<Mat3> normal_tensors_;
+  DesignResult directions_only_;
+  SparseMatrix divergence_;                           ///< T of the uncut model, for the residual display
+  std::string cut_key_;                               ///< what preview_model_ was cut with
+  CutPlan plan_;
   std::vector<Vec6> stress_kPa_;                      ///< of the last design (per cell), for exports
   std::vector<Vec3> displacement_mm_;                 ///< of the last preview (per vertex of preview_model_)
   std::shared_ptr<TissueModel> preview_model_;        ///< the model cut by the preview and the user's cuts
   std::unique_ptr<RenderSurface> preview_surface_;
+  std::unique_ptr<BodySurface> cut_body_surface_;     ///< of preview_model_, for the measurements
 
   const StudioSession& session_;
   std::function<void(std::string)> send_;

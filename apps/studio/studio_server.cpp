@@ -106,14 +106,15 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
         bool design_changed = false;
         nlohmann::json reply = self->server_.handle_text(text, design_changed);
         const bool is_hello = reply.value("type", "") == "state" && text.find("\"hello\"") != std::string::npos;
+        // The new state reaches every client before the sender's acknowledgement, so a client
+        // that acts on the ack already holds the state it acknowledges.
+        if (design_changed)
+          self->server_.broadcast_now(std::make_shared<const std::string>(self->server_.session.state_message().dump()));
         self->send(std::make_shared<const std::string>(reply.dump()));
         if (is_hello && self->server_.hooks.welcome_messages)
           for (std::string& m : self->server_.hooks.welcome_messages())
             self->send(std::make_shared<const std::string>(std::move(m)));
-        if (design_changed) {
-          self->server_.broadcast_now(std::make_shared<const std::string>(self->server_.session.state_message().dump()));
-          if (self->server_.hooks.design_changed) self->server_.hooks.design_changed(self->server_.session);
-        }
+        if (design_changed && self->server_.hooks.design_changed) self->server_.hooks.design_changed(self->server_.session);
       }
       self->read();
     });

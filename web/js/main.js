@@ -33,25 +33,27 @@ function onMessage(m) {
     app.resultCount++;
     viewer.setResult(m);
     refreshDesign();
-    const t = m.timings_ms || {};
-    $('timings').textContent = Object.entries(t).map(([k, v]) => `${k} ${v.toFixed(0)} ms`).join(' · ');
+    showTimings(m.timings_ms || {});
+    showNotes(m);
     $('progress').hidden = true;
     if (m.wounds && m.wounds.length) {
       app.wound = m.wounds[m.wounds.length - 1];
-      $('wound-width').textContent = `${app.wound.width_mm.toFixed(1)} mm`;
+      $('wound-width').textContent = `${app.wound.width_mm.toFixed(1)} mm (max), ${app.wound.mean_width_mm.toFixed(2)} mm (mean)`;
     } else {
       app.wound = null;
       $('wound-width').textContent = '–';
     }
     $('model-info').textContent = `${app.state ? app.state.model.source : ''} · ${m.cells} cells · ${m.cell_size_mm.toFixed(2)} mm`;
   } else if (m.type === 'frame') {
+    // The wound opening, streamed step by step before the final result.
     app.frames++;
-    if (viewer.mesh && m.positions_mm && m.positions_mm.length === viewer.mesh.geometry.attributes.position.array.length) {
-      viewer.mesh.geometry.attributes.position.array.set(m.positions_mm);
-      viewer.mesh.geometry.attributes.position.needsUpdate = true;
-      viewer.mesh.geometry.computeVertexNormals();
-    }
-    if (m.width_mm !== undefined) $('wound-width').textContent = `${m.width_mm.toFixed(1)} mm (t = ${(m.time_s * 1000).toFixed(0)} ms)`;
+    app.lastFrame = { index: m.index, time_s: m.time_s, width_mm: m.width_mm, step_ms: m.step_ms };
+    viewer.showFrame(m.positions_mm, m.triangles);
+    const width = m.width_mm !== undefined ? `${m.width_mm.toFixed(2)} mm` : '–';
+    $('wound-width').textContent = `${width} (t = ${(m.time_s * 1000).toFixed(0)} ms)`;
+    $('progress').hidden = false;
+    $('progress').querySelector('.fill').style.width = `${((100 * m.index) / m.frames).toFixed(0)}%`;
+    $('progress').querySelector('.text').textContent = `opening the wound: frame ${m.index}/${m.frames} · ${m.step_ms.toFixed(0)} ms per step`;
   } else if (m.type === 'progress') {
     $('progress').hidden = false;
     $('progress').querySelector('.fill').style.width = `${(100 * m.fraction).toFixed(0)}%`;
@@ -59,6 +61,28 @@ function onMessage(m) {
   } else if (m.type === 'error') {
     setMessage(m.message, true);
   }
+}
+
+const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', cuts: 'cut model', opening: 'wound opening (frames)',
+  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', total: 'edit to picture' };
+function showTimings(t) {
+  const rows = Object.keys(STAGES).filter((k) => t[k] !== undefined).map((k) => {
+    const tr = document.createElement('tr');
+    tr.innerHTML = `<td>${STAGES[k]}</td><td>${t[k].toFixed(0)} ms</td>`;
+    return tr;
+  });
+  $('timing-table').replaceChildren(...rows);
+  $('timing-total').textContent = t.total !== undefined ? `${t.total.toFixed(0)} ms` : '–';
+  $('timings').textContent = Object.entries(t).map(([k, v]) => `${k} ${v.toFixed(0)} ms`).join(' · ');
+}
+
+/// What the last result could not compute, shown in the page (the rest of the result still is).
+function showNotes(m) {
+  const notes = [];
+  if (m.eigenvalue_note) notes.push(['note', m.eigenvalue_note]);
+  for (const key of ['design_error', 'cut_error']) if (m[key]) notes.push(['error', m[key]]);
+  if (m.equilibrium_residual) notes.push(['note', `equilibrium residual ||T σ|| / (||T|| ||σ||) = ${m.equilibrium_residual.final.toExponential(2)}`]);
+  $('notes').replaceChildren(...notes.map(([cls, text]) => { const d = document.createElement('div'); d.className = cls; d.textContent = text; return d; }));
 }
 
 const connection = new Connection(`ws://${location.host}/ws`, onMessage, (up) => {

@@ -77,6 +77,32 @@ export class Viewer {
     this.applyDisplay();
   }
 
+  /// A simulation frame of the wound opening: new positions (and, on the first frame, the
+  /// triangles of the cut surface). The body colour is shown until the result arrives.
+  showFrame(positions, triangles) {
+    if (!this.mesh) return;
+    if (triangles) {
+      const g = new THREE.BufferGeometry();
+      g.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
+      g.setIndex(triangles);
+      const colors = new Float32Array(positions.length);
+      for (let i = 0; i < colors.length; i += 3) colors.set(BODY_COLOR, i);
+      g.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
+      g.computeVertexNormals();
+      this.scene.remove(this.mesh);
+      this.mesh.geometry.dispose();
+      this.mesh = new THREE.Mesh(g, this.material);
+      this.scene.add(this.mesh);
+      this.fieldOverlay.clear();
+      return;
+    }
+    const attr = this.mesh.geometry.attributes.position;
+    if (attr.array.length !== positions.length) return;
+    attr.array.set(positions);
+    attr.needsUpdate = true;
+    this.mesh.geometry.computeVertexNormals();
+  }
+
   resetView() {
     if (!this.bounds) return;
     const centre = this.bounds.lo.clone().add(this.bounds.hi).multiplyScalar(0.5);
@@ -131,29 +157,31 @@ export class Viewer {
     const n = colors.count;
     const legend = document.getElementById('legend');
     this.fieldOverlay.clear();
+    // [field, title, unit, ramp]; negative values of the cut-face fields mark vertices off the cut faces.
     const scalar = { langer: ['langer_kPa', 'Eigenvalue along Langer', 'kPa', 'tension'],
                      cross: ['cross_kPa', 'Eigenvalue across Langer', 'kPa', 'tension'],
-                     residual: ['residual', 'Equilibrium residual', 'kPa', 'tension'],
-                     depth: ['depth', 'Incision depth', 'relative', 'depth'],
-                     traction: ['traction_kPa', 'Released traction', 'kPa', 'tension'] }[this.display];
+                     residual: ['residual_kPa', 'Equilibrium residual |Tσ|/h²', 'kPa', 'tension'],
+                     displacement: ['displacement_mm', 'Displacement', 'mm', 'tension'],
+                     depth: ['cut_depth', 'Cut faces by depth (0 skin, 1 inner layer)', 'relative', 'depth', true],
+                     traction: ['traction_kPa', 'Cut faces by released traction', 'kPa', 'tension', true] }[this.display];
     const values = scalar ? fields[scalar[0]] : null;
-    let lo = 0, hi = 1;
-    if (values && values.length === n) {
-      lo = Math.min(...values); hi = Math.max(...values);
-      if (!(hi > lo)) hi = lo + 1;
-    }
+    const shown = values && values.length === n;
+    const onCut = (v) => !scalar[4] || v >= 0;
+    let lo = Infinity, hi = -Infinity;
+    if (shown) for (const v of values) if (onCut(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
+    if (!(hi > lo)) { lo = Number.isFinite(lo) ? lo : 0; hi = lo + 1; }
     for (let i = 0; i < n; i++) {
-      const c = values && values.length === n ? rampColor(scalar[3], (values[i] - lo) / (hi - lo)) : BODY_COLOR;
+      const c = shown && onCut(values[i]) ? rampColor(scalar[3], (values[i] - lo) / (hi - lo)) : BODY_COLOR;
       colors.setXYZ(i, c[0], c[1], c[2]);
     }
     colors.needsUpdate = true;
     if (scalar) {
       legend.hidden = false;
-      legend.querySelector('.title').textContent = values && values.length === n
-        ? `${scalar[1]} (${scalar[2]})` : `${scalar[1]}: not computed`;
+      legend.querySelector('.title').textContent = shown ? `${scalar[1]} (${scalar[2]})` : `${scalar[1]}: not computed yet`;
       legend.querySelector('.ramp').style.background = rampCss(scalar[3]);
-      legend.querySelector('.lo').textContent = values && values.length === n ? lo.toFixed(2) : '';
-      legend.querySelector('.hi').textContent = values && values.length === n ? hi.toFixed(2) : '';
+      const digits = hi - lo < 0.1 ? 4 : 2;
+      legend.querySelector('.lo').textContent = shown ? `${lo.toFixed(digits)}` : '';
+      legend.querySelector('.hi').textContent = shown ? `${hi.toFixed(digits)}` : '';
     } else {
       legend.hidden = true;
     }
@@ -186,11 +214,13 @@ export class Viewer {
 
   buildStreamlines(lines) {
     if (!lines) return;
-    for (const line of lines) {
-      const g = new THREE.BufferGeometry();
-      g.setAttribute('position', new THREE.Float32BufferAttribute(line.flat(), 3));
-      this.fieldOverlay.add(new THREE.Line(g, new THREE.LineBasicMaterial({ color: 0xffd400 })));
-    }
+    // Each line is a flat [x, y, z, x, y, z, ...] array (mm); drawn as one set of segments.
+    const pts = [];
+    for (const line of lines)
+      for (let i = 3; i < line.length; i += 3) pts.push(line[i - 3], line[i - 2], line[i - 1], line[i], line[i + 1], line[i + 2]);
+    const g = new THREE.BufferGeometry();
+    g.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
+    this.fieldOverlay.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color: 0xffd400 })));
   }
 
   /// Draws the design: strokes (red), cut paths (dark), control points with their tensor frame.
