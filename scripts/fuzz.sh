@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Builds the libFuzzer targets (preset `fuzz`, clang + ASan + UBSan) and runs each for a bounded
-# time on its seed corpus. Any crash fails the run and leaves the input in build/fuzz/crashes/.
+# time on its seed corpus and the inputs that once failed (tests/fuzz/regressions/). Any crash
+# fails the run and leaves the input in build/fuzz/crashes/. Leaks inside teem's own error
+# paths are suppressed (tests/fuzz/lsan.supp).
 # Usage: scripts/fuzz.sh [--seconds N]   (default 20 s per target)
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -17,8 +19,8 @@ for target in build/fuzz/fuzz/fuzz_*; do
   work="build/fuzz/corpus/${name#fuzz_}"
   mkdir -p "$work" "$corpus_seed"
   echo "-- $name for ${seconds}s"
-  if ! ASAN_OPTIONS=detect_leaks=1 "$target" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=4096 \
-        -artifact_prefix="build/fuzz/crashes/${name}-" "$work" "$corpus_seed" 2>"build/fuzz/$name.log"; then
+  if ! ASAN_OPTIONS=detect_leaks=1 LSAN_OPTIONS=suppressions=tests/fuzz/lsan.supp "$target" -max_total_time="$seconds" -max_len=65536 -rss_limit_mb=4096 \
+        -artifact_prefix="build/fuzz/crashes/${name}-" "$work" "$corpus_seed" "tests/fuzz/regressions/${name#fuzz_}" 2>"build/fuzz/$name.log"; then
     echo "FAIL $name: see build/fuzz/$name.log and build/fuzz/crashes/"
     tail -30 "build/fuzz/$name.log"
     status=1

@@ -43,7 +43,7 @@ MessageOutcome dispatch(StudioSession& session, const nlohmann::json& message,
   const nlohmann::json* cmd_value = json_find(message, "cmd");
   if (!cmd_value || !cmd_value->is_string())
     throw InputError(fmt::format("message: \"cmd\" is {}; expected a command name ({})",
-                                 cmd_value ? cmd_value->dump().substr(0, 80) : "missing", kCommandList));
+                                 cmd_value ? utf8_prefix(cmd_value->dump(), 80) : "missing", kCommandList));
   const std::string cmd = cmd_value->get<std::string>();
   MessageOutcome out;
   if (cmd == "hello" || cmd == "get_state") {
@@ -73,7 +73,7 @@ MessageOutcome dispatch(StudioSession& session, const nlohmann::json& message,
     exporter(format, file);
     out.reply = {{"type", "exported"}, {"file", file.filename().string()}};
   } else {
-    throw InputError(fmt::format("unknown command '{}'; expected one of {}", cmd.substr(0, 80), kCommandList));
+    throw InputError(fmt::format("unknown command '{}'; expected one of {}", utf8_prefix(cmd, 80), kCommandList));
   }
   return out;
 }

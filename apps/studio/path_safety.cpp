@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/io/json_fields.hpp"
 
 namespace cleave::studio {
 namespace {
@@ -49,7 +50,7 @@ std::filesystem::path require_inside(const std::filesystem::path& root, std::str
   auto p = resolve_inside(root, relative);
   if (!p)
     throw InputError(fmt::format("{} '{}' is outside the session folder; expected a file name such as design.json", what,
-                                 std::string(relative.substr(0, 200))));
+                                 utf8_prefix(relative, 200)));
   return *p;
 }
 

@@ -37,4 +37,12 @@ void check_image_volume(const ImageVolume& image) {
       throw InputError(fmt::format("{}: sample {} is {}; expected finite values", f, n, image.values[n]));
 }
 
+std::uint64_t checked_sample_count(std::uint64_t nx, std::uint64_t ny, std::uint64_t nz, const std::string& file) {
+  std::uint64_t nxy = 0, samples = 0;
+  if (__builtin_mul_overflow(nx, ny, &nxy) || __builtin_mul_overflow(nxy, nz, &samples))
+    throw InputError(fmt::format("{}: image size {}x{}x{} has more than 2^64 samples; the header is corrupt", file, nx,
+                                 ny, nz));
+  return samples;
+}
+
 }  // namespace cleave

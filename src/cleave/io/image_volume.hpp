@@ -39,4 +39,9 @@ struct ImageVolume {
 /// positive spacing").
 void check_image_volume(const ImageVolume& image);
 
+/// Samples of an nx x ny x nz image (sizes as the file declares them), or InputError naming
+/// `file` when the product does not fit in 64 bits: a header may declare sizes whose product
+/// wraps around to a small number, which must never reach an allocation.
+std::uint64_t checked_sample_count(std::uint64_t nx, std::uint64_t ny, std::uint64_t nz, const std::string& file);
+
 }  // namespace cleave

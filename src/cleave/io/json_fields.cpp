@@ -8,13 +8,56 @@
 namespace cleave {
 namespace {
 
+constexpr std::size_t kMaxDescribedBytes = 60;  // a value quoted in an error message
+
 std::string describe(const nlohmann::json& value) {
   std::string text = value.dump(-1, ' ', true, nlohmann::json::error_handler_t::replace);
-  if (text.size() > 60) text = text.substr(0, 57) + "...";
+  if (text.size() > kMaxDescribedBytes) text = utf8_prefix(text, kMaxDescribedBytes - 3) + "...";
   return text;
 }
 
+/// Length of the well-formed UTF-8 sequence starting at text[i], or 0 when it is not one.
+std::size_t utf8_sequence_length(std::string_view text, std::size_t i) {
+  const auto byte = [&](std::size_t k) { return static_cast<unsigned char>(text[k]); };
+  const unsigned char b = byte(i);
+  std::size_t n = 0;
+  unsigned lo = 0x80, hi = 0xBF;  // allowed range of the second byte (no overlongs, no surrogates)
+  if (b < 0x80) return 1;
+  if (b >= 0xC2 && b <= 0xDF) n = 2;
+  else if (b >= 0xE0 && b <= 0xEF) { n = 3; if (b == 0xE0) lo = 0xA0; if (b == 0xED) hi = 0x9F; }
+  else if (b >= 0xF0 && b <= 0xF4) { n = 4; if (b == 0xF0) lo = 0x90; if (b == 0xF4) hi = 0x8F; }
+  else return 0;
+  if (i + n > text.size()) return 0;
+  if (byte(i + 1) < lo || byte(i + 1) > hi) return 0;
+  for (std::size_t k = 2; k < n; ++k)
+    if (byte(i + k) < 0x80 || byte(i + k) > 0xBF) return 0;
+  return n;
+}
+
 }  // namespace
+
+std::string utf8_sanitized(std::string_view text) {
+  std::string out;
+  out.reserve(text.size());
+  for (std::size_t i = 0; i < text.size();) {
+    const std::size_t n = utf8_sequence_length(text, i);
+    if (n == 0) {
+      out += "\xEF\xBF\xBD";  // U+FFFD
+      ++i;
+    } else {
+      out.append(text.substr(i, n));
+      i += n;
+    }
+  }
+  return out;
+}
+
+std::string utf8_prefix(std::string_view text, std::size_t max_bytes) {
+  if (text.size() <= max_bytes) return std::string(text);
+  std::size_t end = max_bytes;
+  while (end > 0 && (static_cast<unsigned char>(text[end]) & 0xC0) == 0x80) --end;  // continuation byte
+  return std::string(text.substr(0, end));
+}
 
 void json_error(const JsonPath& at, const nlohmann::json& value, const std::string& expected) {
   throw InputError(fmt::format("{} is {}; expected {}", at.str(), describe(value), expected));
@@ -108,13 +151,13 @@ nlohmann::json parse_json_text(const std::string& text, const std::string& file)
     std::string reason = e.what();
     const auto colon = reason.find("syntax error");
     if (colon != std::string::npos) reason = reason.substr(colon);
-    throw InputError(fmt::format("{}: invalid JSON at byte {}: {}", file, e.byte, reason));
+    throw InputError(fmt::format("{}: invalid JSON at byte {}: {}", file, e.byte, utf8_sanitized(reason)));
   } catch (const nlohmann::json::exception& e) {
     // e.g. out_of_range.406 "number overflow parsing '1e999'"
     std::string reason = e.what();
     const auto bracket = reason.find("] ");
     if (bracket != std::string::npos) reason = reason.substr(bracket + 2);
-    throw InputError(fmt::format("{}: invalid JSON: {}", file, reason));
+    throw InputError(fmt::format("{}: invalid JSON: {}", file, utf8_sanitized(reason)));
   }
 }
 

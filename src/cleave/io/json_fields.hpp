@@ -4,6 +4,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cleave/core/types.hpp"
@@ -45,7 +46,17 @@ inline const nlohmann::json* json_find(const nlohmann::json& object, const std::
 }
 
 /// Parses JSON text; syntax errors become InputError with file, line/byte and nlohmann's reason.
-/// Refuses nesting deeper than 64 levels.
+/// Refuses nesting deeper than 64 levels. The message is valid UTF-8 even when the text is not
+/// (nlohmann quotes the offending bytes; they are replaced by U+FFFD), so that it can be sent
+/// back as JSON.
 nlohmann::json parse_json_text(const std::string& text, const std::string& file);
+
+/// `text` with every byte that is not part of a well-formed UTF-8 sequence replaced by U+FFFD.
+std::string utf8_sanitized(std::string_view text);
+
+/// The longest prefix of valid UTF-8 `text` of at most `max_bytes` bytes that does not cut a
+/// character in two (a cut character would make the message invalid UTF-8, which nlohmann's
+/// dump refuses with an exception).
+std::string utf8_prefix(std::string_view text, std::size_t max_bytes);
 
 }  // namespace cleave

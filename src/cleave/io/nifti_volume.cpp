@@ -3,6 +3,7 @@
 #include <cmath>
 #include <cstdlib>
 #include <fmt/format.h>
+#include <limits>
 #include <memory>
 #include <nifti2_io.h>
 
@@ -28,22 +29,31 @@ double unit_to_mm(int xyz_units) {
   }
 }
 
+constexpr std::int64_t kMaxNiftiDims = 7;  // dim[0]: the number of dimensions, 1 to 7
+
 /// Raw pixdim[1..3] of the header on disk (nifticlib replaces a zero pixdim by 1 when it builds
-/// the image, which would hide a broken file).
+/// the image, which would hide a broken file). Also refuses a dim[0] outside 1..7 before
+/// nifti_image_read sees it: nifticlib copies dim[1..dim[0]] into a fixed array of 8 (a
+/// NIfTI-2 header with dim[0] = 2^32 + 3 overflowed its stack; found by fuzz_nifti).
 Vec3 raw_pixdims(const std::string& f) {
   int version = 0;
   void* header = nifti_read_header(f.c_str(), &version, /*check=*/1);
   if (header == nullptr)
     throw InputError(fmt::format("{}: not a readable NIfTI-1/NIfTI-2 file (missing, truncated or malformed header)", f));
   Vec3 pixdim;
+  std::int64_t dimensions = 0;
   if (version == 2) {
     const auto* h = static_cast<const nifti_2_header*>(header);
     pixdim = {h->pixdim[1], h->pixdim[2], h->pixdim[3]};
+    dimensions = h->dim[0];
   } else {
     const auto* h = static_cast<const nifti_1_header*>(header);
     pixdim = {static_cast<double>(h->pixdim[1]), static_cast<double>(h->pixdim[2]), static_cast<double>(h->pixdim[3])};
+    dimensions = h->dim[0];
   }
   std::free(header);
+  if (dimensions < 1 || dimensions > kMaxNiftiDims)
+    throw InputError(fmt::format("{}: header dim[0] is {}; expected 1 to 7 dimensions", f, dimensions));
   return pixdim;
 }
 
@@ -89,16 +99,23 @@ ImageVolume read_nifti_volume(const std::filesystem::path& file) {
   if (!is_scalar_type(nim->datatype))
     throw InputError(fmt::format("{}: sample type {} is not a scalar number; expected integer or real samples", f,
                                  nifti_datatype_string(nim->datatype)));
-  if (nim->nt * nim->nu * nim->nv * nim->nw > 1)
-    throw InputError(fmt::format("{}: holds {} volumes; expected a single 3-D volume", f,
-                                 nim->nt * nim->nu * nim->nv * nim->nw));
+  // nt..nw may be anything a corrupt header declares: compare them one by one (their product
+  // can overflow).
+  for (const auto extra : {nim->nt, nim->nu, nim->nv, nim->nw})
+    if (extra > 1)
+      throw InputError(fmt::format("{}: holds {}x{}x{}x{} volumes; expected a single 3-D volume", f, nim->nt, nim->nu,
+                                   nim->nv, nim->nw));
   if (nim->nx <= 0 || nim->ny <= 0 || nim->nz <= 0 || nim->nx > std::numeric_limits<int>::max() ||
       nim->ny > std::numeric_limits<int>::max() || nim->nz > std::numeric_limits<int>::max())
     throw InputError(fmt::format("{}: image size {}x{}x{}; expected 1 to 2^31 samples along each axis", f, nim->nx,
                                  nim->ny, nim->nz));
-  const auto samples = static_cast<std::uint64_t>(nim->nx) * static_cast<std::uint64_t>(nim->ny) *
-                       static_cast<std::uint64_t>(nim->nz);
-  require_memory(samples * (static_cast<std::uint64_t>(nim->nbyper) + sizeof(double)),
+  const std::uint64_t samples =
+      checked_sample_count(static_cast<std::uint64_t>(nim->nx), static_cast<std::uint64_t>(nim->ny),
+                           static_cast<std::uint64_t>(nim->nz), f);
+  std::uint64_t bytes = 0;
+  if (__builtin_mul_overflow(samples, static_cast<std::uint64_t>(nim->nbyper) + sizeof(double), &bytes))
+    bytes = std::numeric_limits<std::uint64_t>::max();
+  require_memory(bytes,
                  fmt::format("{} ({}x{}x{} samples)", f, nim->nx, nim->ny, nim->nz));
 
   ImageVolume image;

@@ -3,8 +3,11 @@
 #include <cmath>
 #include <cstdlib>
 #include <fmt/format.h>
+#include <fstream>
+#include <limits>
 #include <memory>
 #include <string>
+#include <string_view>
 #include <teem/nrrd.h>
 
 #include "cleave/core/error.hpp"
@@ -40,6 +43,16 @@ Vec3 flips_to_ras(int space) {
   }
 }
 
+/// teem also reads PNM, VTK and plain-text tables, and leaks memory on some of their error paths;
+/// a .nrrd / .nhdr file must start with the NRRD magic, so anything else is refused before teem.
+void require_nrrd_magic(const std::filesystem::path& file) {
+  std::ifstream in(file, std::ios::binary);
+  char magic[7] = {};
+  in.read(magic, sizeof magic);
+  if (in.gcount() != sizeof magic || std::string_view(magic, sizeof magic) != "NRRD000")
+    throw InputError(fmt::format("{}: not a NRRD file (expected the magic 'NRRD000' at the start)", file.string()));
+}
+
 NrrdPtr load(const std::filesystem::path& file, bool header_only) {
   NrrdPtr nrrd(nrrdNew());
   std::unique_ptr<NrrdIoState, NrrdIoDeleter> nio(nrrdIoStateNew());
@@ -55,6 +68,7 @@ ImageVolume read_nrrd_volume(const std::filesystem::path& file) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(file, ec)) throw InputError(fmt::format("{}: no such file", file.string()));
   const std::string f = file.string();
+  require_nrrd_magic(file);
 
   // Header first: check the shape and the memory before teem allocates the data.
   NrrdPtr header = load(file, /*header_only=*/true);
@@ -65,9 +79,12 @@ ImageVolume read_nrrd_volume(const std::filesystem::path& file) {
     if (header->dim == 3 || header->axis[a].size > 1) axes.push_back(a);
   if (axes.size() != 3)
     throw InputError(fmt::format("{}: has {} axes; expected a 3-D volume", f, header->dim));
-  std::uint64_t samples = 1;
-  for (unsigned a : axes) samples *= header->axis[a].size;
-  require_memory(samples * (nrrdTypeSize[header->type] + sizeof(double)),
+  const std::uint64_t samples = checked_sample_count(header->axis[axes[0]].size, header->axis[axes[1]].size,
+                                                     header->axis[axes[2]].size, f);
+  std::uint64_t bytes = 0;
+  if (__builtin_mul_overflow(samples, nrrdTypeSize[header->type] + sizeof(double), &bytes))
+    bytes = std::numeric_limits<std::uint64_t>::max();
+  require_memory(bytes,
                  fmt::format("{} ({}x{}x{} samples)", f, header->axis[axes[0]].size, header->axis[axes[1]].size,
                              header->axis[axes[2]].size));
 

@@ -9,8 +9,17 @@
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/off_mesh_file.hpp"
+#include "cleave/io/ply_precheck.hpp"
 
 namespace cleave {
+namespace {
+
+[[noreturn]] void fail_import(const std::string& file, std::string why) {
+  while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
+  throw InputError(fmt::format("{}: cannot read the mesh: {}", file, why.empty() ? "unknown format" : why));
+}
+
+}  // namespace
 
 SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
   const std::string f = file.string();
@@ -30,20 +39,35 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
     return mesh;
   }
 
+  if (extension == ".ply") require_well_formed_ply(file);  // assimp reads past a truncated one
+
   Assimp::Importer importer;
   // Keep points and lines out (only triangles bound a volume); no normals or UVs are needed.
   // Per-face normals (STL) and other attributes would keep identical positions apart when joining.
   importer.SetPropertyInteger(AI_CONFIG_PP_SBP_REMOVE, aiPrimitiveType_POINT | aiPrimitiveType_LINE);
   importer.SetPropertyInteger(AI_CONFIG_PP_RVC_FLAGS, aiComponent_NORMALS | aiComponent_TANGENTS_AND_BITANGENTS |
                                                           aiComponent_COLORS | aiComponent_TEXCOORDS);
-  const aiScene* scene =
-      importer.ReadFile(f, aiProcess_RemoveComponent | aiProcess_Triangulate | aiProcess_JoinIdenticalVertices |
-                               aiProcess_PreTransformVertices | aiProcess_SortByPType);
-  if (scene == nullptr) {
-    std::string why = importer.GetErrorString();
-    while (!why.empty() && (why.back() == '\n' || why.back() == ' ')) why.pop_back();
-    throw InputError(fmt::format("{}: cannot read the mesh: {}", f, why.empty() ? "unknown format" : why));
+  // Import first, check the faces, then post-process: assimp's importers can produce a face
+  // with no corners from a malformed file (ASCII PLY with garbage in a face line), which
+  // ValidateDataStructure lets through and Triangulate / SortByPType then abort or crash on
+  // (found by fuzz_mesh_ply).
+  const aiScene* raw = importer.ReadFile(f, aiProcess_ValidateDataStructure);
+  if (raw == nullptr) fail_import(f, importer.GetErrorString());
+  for (unsigned m = 0; m < raw->mNumMeshes; ++m) {
+    const aiMesh& part = *raw->mMeshes[m];
+    for (unsigned t = 0; t < part.mNumFaces; ++t) {
+      const aiFace& face = part.mFaces[t];
+      if (face.mNumIndices == 0 || face.mIndices == nullptr)
+        fail_import(f, fmt::format("face {} has no vertices (malformed face)", t));
+      for (unsigned k = 0; k < face.mNumIndices; ++k)
+        if (face.mIndices[k] >= part.mNumVertices)
+          fail_import(f, fmt::format("face {} refers to vertex {}; the mesh has {} vertices", t, face.mIndices[k], part.mNumVertices));
+    }
   }
+  const aiScene* scene = importer.ApplyPostProcessing(aiProcess_RemoveComponent | aiProcess_Triangulate |
+                                                      aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
+                                                      aiProcess_SortByPType);
+  if (scene == nullptr) fail_import(f, importer.GetErrorString());
   SurfaceMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh& part = *scene->mMeshes[m];

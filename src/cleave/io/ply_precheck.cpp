@@ -1,0 +1,132 @@
+#include "cleave/io/ply_precheck.hpp"
+
+#include <algorithm>
+#include <cstdint>
+#include <fmt/format.h>
+#include <sstream>
+#include <string>
+#include <vector>
+
+#include "cleave/core/error.hpp"
+#include "cleave/io/atomic_file.hpp"
+
+namespace cleave {
+namespace {
+
+/// Bytes of a PLY scalar type name, 0 when unknown.
+std::size_t type_bytes(const std::string& type) {
+  if (type == "char" || type == "uchar" || type == "int8" || type == "uint8") return 1;
+  if (type == "short" || type == "ushort" || type == "int16" || type == "uint16") return 2;
+  if (type == "int" || type == "uint" || type == "float" || type == "int32" || type == "uint32" || type == "float32")
+    return 4;
+  if (type == "double" || type == "float64") return 8;
+  return 0;
+}
+
+struct PlyProperty {
+  std::size_t bytes = 0;        ///< scalar size, or the size of one list item
+  std::size_t count_bytes = 0;  ///< size of the list count (0: not a list)
+};
+
+struct PlyElement {
+  std::string name;
+  std::uint64_t count = 0;
+  std::vector<PlyProperty> properties;
+};
+
+/// Reads an unsigned list count of `bytes` bytes at `p` (a negative signed count reads huge).
+std::uint64_t list_count(const unsigned char* p, std::size_t bytes, bool big_endian) {
+  std::uint64_t v = 0;
+  for (std::size_t k = 0; k < bytes; ++k) v |= std::uint64_t{p[big_endian ? bytes - 1 - k : k]} << (8 * k);
+  return v;
+}
+
+}  // namespace
+
+void require_well_formed_ply(const std::filesystem::path& file) {
+  const std::string data = read_file(file);
+  const std::string f = file.string();
+  const std::size_t header_end = data.find("end_header");
+  if (data.rfind("ply", 0) != 0 || header_end == std::string::npos)
+    throw InputError(fmt::format("{}: not a PLY file (expected 'ply' first and an 'end_header' line)", f));
+  const auto malformed = [&](const std::string& line) {
+    throw InputError(fmt::format("{}: malformed PLY header line '{}'", f, line.substr(0, 80)));
+  };
+  std::size_t pos = data.find('\n', header_end);
+  pos = pos == std::string::npos ? data.size() : pos + 1;
+  std::istringstream header(data.substr(0, header_end));
+  bool binary = false, big_endian = false;
+  std::vector<PlyElement> elements;
+  for (std::string line; std::getline(header, line);) {
+    std::istringstream words(line);
+    std::string keyword;
+    words >> keyword;
+    if (keyword == "format") {
+      std::string format;
+      words >> format;
+      binary = format == "binary_little_endian" || format == "binary_big_endian";
+      big_endian = format == "binary_big_endian";
+    } else if (keyword == "element") {
+      PlyElement e;
+      long long count = -1;
+      words >> e.name >> count;
+      if (words.fail() || count < 0) malformed(line);
+      e.count = static_cast<std::uint64_t>(count);
+      elements.push_back(e);
+    } else if (keyword == "property") {
+      if (elements.empty()) malformed(line);
+      std::string type;
+      words >> type;
+      PlyProperty p;
+      if (type == "list") {
+        std::string count_type, item_type;
+        words >> count_type >> item_type;
+        p.count_bytes = type_bytes(count_type);
+        p.bytes = type_bytes(item_type);
+        if (p.count_bytes == 0 || p.bytes == 0) malformed(line);
+      } else {
+        p.bytes = type_bytes(type);
+        if (p.bytes == 0) malformed(line);
+      }
+      elements.back().properties.push_back(p);
+    }
+  }
+  if (!binary) return;
+  const auto truncated = [&](const PlyElement& e, std::uint64_t item) {
+    throw InputError(fmt::format("{}: the binary data ends at byte {} while reading element '{}' {} of {} (truncated?)",
+                                 f, data.size(), e.name, item, e.count));
+  };
+  const std::size_t size = data.size();
+  for (const PlyElement& e : elements) {
+    // Elements without list properties have a fixed size: check them in one step.
+    std::uint64_t fixed = 0;
+    bool has_list = false;
+    for (const PlyProperty& p : e.properties) {
+      fixed += p.bytes;
+      has_list = has_list || p.count_bytes > 0;
+    }
+    if (!has_list) {
+      std::uint64_t bytes = 0;
+      if (__builtin_mul_overflow(fixed, e.count, &bytes) || bytes > size - pos) truncated(e, (size - pos) / std::max<std::uint64_t>(fixed, 1));
+      pos += static_cast<std::size_t>(bytes);
+      continue;
+    }
+    for (std::uint64_t item = 0; item < e.count; ++item) {
+      for (const PlyProperty& p : e.properties) {
+        if (p.count_bytes == 0) {
+          if (p.bytes > size - pos) truncated(e, item);
+          pos += p.bytes;
+          continue;
+        }
+        if (p.count_bytes > size - pos) truncated(e, item);
+        const std::uint64_t n = list_count(reinterpret_cast<const unsigned char*>(data.data() + pos), p.count_bytes, big_endian);
+        pos += p.count_bytes;
+        std::uint64_t bytes = 0;
+        if (__builtin_mul_overflow(n, p.bytes, &bytes) || bytes > size - pos) truncated(e, item);
+        pos += static_cast<std::size_t>(bytes);
+      }
+    }
+  }
+}
+
+}  // namespace cleave

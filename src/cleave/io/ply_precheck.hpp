@@ -1,0 +1,17 @@
+#pragma once
+// A guard in front of assimp's PLY importer, which reads past the end of its buffer on a PLY
+// without "end_header" and on a binary PLY whose header declares more data than the file holds
+// (segmentation faults found by fuzz_mesh_ply and by the bad-input catalogue).
+#include <filesystem>
+
+namespace cleave {
+
+/// Throws InputError naming `file` unless it starts with "ply", has an "end_header" line, and
+/// every element and property line of its header is well formed (known scalar types, counts
+/// from 0). For a binary PLY (little- or big-endian) it also walks the declared elements, list
+/// counts included, and refuses data shorter than declared, e.g. "body.ply: the binary data ends
+/// at byte 312 while reading element 'vertex' 2 of 8 (truncated?)". The ASCII body is left to
+/// assimp.
+void require_well_formed_ply(const std::filesystem::path& file);
+
+}  // namespace cleave

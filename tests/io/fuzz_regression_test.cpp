@@ -1,0 +1,128 @@
+// Replays every input that once crashed, leaked or tripped a sanitizer in a fuzz target
+// (tests/fuzz/regressions/<target>/): each must now give a volume or mesh or one InputError.
+// Under the asan preset this also re-checks them for memory errors. The specific findings get
+// their exact messages below (docs/ROBUSTNESS.md lists them).
+#include <filesystem>
+#include <functional>
+#include <gtest/gtest.h>
+#include <string>
+
+#include "cleave/core/error.hpp"
+#include "cleave/io/json_fields.hpp"
+#include "cleave/io/nifti_volume.hpp"
+#include "cleave/io/nrrd_volume.hpp"
+#include "cleave/io/surface_mesh_file.hpp"
+
+namespace cleave {
+namespace {
+
+const std::filesystem::path kRegressions = std::filesystem::path(CLEAVE_TEST_DATA_DIR) / "fuzz" / "regressions";
+
+/// Runs `read` on every file of regressions/<target>/; returns how many there were.
+template <typename Read>
+int replay(const std::string& target, Read read) {
+  int files = 0;
+  const auto folder = kRegressions / target;
+  if (!std::filesystem::is_directory(folder)) return 0;
+  for (const auto& entry : std::filesystem::directory_iterator(folder)) {
+    ++files;
+    try {
+      read(entry.path());
+    } catch (const InputError& e) {
+      EXPECT_EQ(std::string(e.what()).find('\n'), std::string::npos) << entry.path() << ": " << e.what();
+    }
+  }
+  return files;
+}
+
+std::string error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no InputError";
+}
+
+TEST(FuzzRegressions, EveryFormerCrashGivesAResultOrOneInputError) {
+  int files = 0;
+  files += replay("nrrd", [](const auto& p) { (void)read_nrrd_volume(p); });
+  files += replay("nifti", [](const auto& p) { (void)read_nifti_volume(p); });
+  for (const char* format : {"mesh_obj", "mesh_stl", "mesh_ply", "mesh_off"})
+    files += replay(format, [](const auto& p) { (void)read_surface_mesh(p, 1.0); });
+  EXPECT_GE(files, 2);
+}
+
+// fuzz_nifti: a NIfTI-2 header with dim[0] = 2^32 + 3 overflowed nifticlib's stack in
+// nifti_image_read (it copies dim[1..dim[0]] into an array of 8).
+TEST(FuzzRegressions, NiftiDimensionCountOutOfRange) {
+  const auto file = kRegressions / "nifti" / "nifti2_dim0_overflow.nii";
+  EXPECT_EQ(error_of([&] { (void)read_nifti_volume(file); }),
+            file.string() + ": header dim[0] is 4294967299; expected 1 to 7 dimensions");
+}
+
+// fuzz_nrrd: bytes without the NRRD magic went to teem's other readers (plain text here), which
+// leak on their error paths.
+TEST(FuzzRegressions, NrrdWithoutMagicIsRefusedBeforeTeem) {
+  const auto file = kRegressions / "nrrd" / "no_magic_teem_leak.nrrd";
+  EXPECT_EQ(error_of([&] { (void)read_nrrd_volume(file); }),
+            file.string() + ": not a NRRD file (expected the magic 'NRRD000' at the start)");
+}
+
+// fuzz_mesh_ply: an ASCII PLY whose first face line is garbage gave assimp a face with no
+// corners, and its Triangulate step aborted the process.
+TEST(FuzzRegressions, PlyFaceWithoutCornersIsRefusedBeforePostProcessing) {
+  const auto file = kRegressions / "mesh_ply" / "ascii_face_without_corners.ply";
+  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+            file.string() + ": cannot read the mesh: face 0 has no vertices (malformed face)");
+}
+
+// fuzz_mesh_ply: a binary PLY header without end_header made assimp read past its buffer.
+TEST(FuzzRegressions, PlyWithoutEndHeaderIsRefusedBeforeAssimp) {
+  const auto file = kRegressions / "mesh_ply" / "binary_without_end_header.ply";
+  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+            file.string() + ": not a PLY file (expected 'ply' first and an 'end_header' line)");
+}
+
+bool is_valid_utf8(const std::string& s) {
+  try {
+    (void)nlohmann::json(s).dump();
+    return true;
+  } catch (const nlohmann::json::exception&) {
+    return false;
+  }
+}
+
+// fuzz_studio_message: a message with invalid UTF-8 inside a string made nlohmann quote the raw
+// bytes in its parse error; the studio put that text in its error reply, and dumping the reply
+// threw (an exception out of the server's read handler ends the server).
+TEST(FuzzRegressions, JsonErrorMessagesAreValidUtf8) {
+  const std::string bad = "{\"cmd\": \"\xf9\xf9vtu\"}";
+  const std::string message = error_of([&] { (void)parse_json_text(bad, "message"); });
+  EXPECT_NE(message.find("invalid JSON at byte"), std::string::npos) << message;
+  EXPECT_TRUE(is_valid_utf8(message)) << message;
+  // A value quoted in an error is cut at 60 bytes without splitting a character.
+  const std::string long_value(30, 'x');
+  const std::string accented = long_value + "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9";
+  const std::string quoted = error_of([&] { json_error(JsonPath{"f", "/cmd"}, nlohmann::json(accented), "a name"); });
+  EXPECT_TRUE(is_valid_utf8(quoted)) << quoted;
+}
+
+TEST(Utf8, SanitizedReplacesMalformedBytesAndKeepsValidText) {
+  EXPECT_EQ(utf8_sanitized("abc"), "abc");
+  EXPECT_EQ(utf8_sanitized("\xc3\xa9"), "\xc3\xa9");                       // e acute
+  EXPECT_EQ(utf8_sanitized("a\xff" "b"), "a\xef\xbf\xbd" "b");             // stray byte
+  EXPECT_EQ(utf8_sanitized("\xc0\xaf"), "\xef\xbf\xbd\xef\xbf\xbd");      // overlong '/'
+  EXPECT_EQ(utf8_sanitized("\xed\xa0\x80"), "\xef\xbf\xbd\xef\xbf\xbd\xef\xbf\xbd");  // surrogate
+  EXPECT_EQ(utf8_sanitized("\xe2\x82"), "\xef\xbf\xbd\xef\xbf\xbd");      // truncated euro sign
+}
+
+TEST(Utf8, PrefixNeverCutsACharacter) {
+  EXPECT_EQ(utf8_prefix("abc", 10), "abc");
+  EXPECT_EQ(utf8_prefix("ab\xc3\xa9", 3), "ab");
+  EXPECT_EQ(utf8_prefix("ab\xc3\xa9", 4), "ab\xc3\xa9");
+  EXPECT_EQ(utf8_prefix("\xe2\x82\xac\xe2\x82\xac", 5), "\xe2\x82\xac");
+}
+
+}  // namespace
+}  // namespace cleave
