@@ -42,7 +42,7 @@ TEST(CaseDesign, ParsesEveryField) {
       "strokes": [{"points": [[0,0,10],[10,0,10]]}, {"points": [[1,1,5],[2,2,5]], "interior": true}],
       "control_points": [{"position": [5,5,10], "langer_kPa": 20, "cross_kPa": 10}],
       "weights": {"laplacian": 2, "constraint": 50, "equilibrium": 0},
-      "equilibrate": false, "solver": "paper-cg", "snap_tolerance_cells": 3})"),
+      "equilibrate": false, "equilibrium_support": "simulation", "solver": "paper-cg", "snap_tolerance_cells": 3})"),
                                            JsonPath{"case.json", "/design"});
   ASSERT_EQ(d.strokes.size(), 2u);
   EXPECT_EQ(d.strokes[0].placement, StrokePlacement::surface);
@@ -54,6 +54,7 @@ TEST(CaseDesign, ParsesEveryField) {
   EXPECT_EQ(d.weights.constraint, 50);
   EXPECT_EQ(d.weights.equilibrium, 0);
   EXPECT_EQ(d.equilibration, Equilibration::none);
+  EXPECT_EQ(d.support, EquilibriumSupport::simulation);
   EXPECT_EQ(d.solver, EigenvalueSolver::paper_cg);
   EXPECT_EQ(d.snap_tolerance_cells, 3);
 }
@@ -82,7 +83,10 @@ TEST(CaseDesign, BadInputNamesThePath) {
             "case.json: /design/weights/equilibrium is -1; expected a finite weight >= 0 (0 = off)");
   EXPECT_EQ(parse_error(R"({"stroke": [], )" + cp + "}"),
             "case.json: /design has unknown key 'stroke'; expected one of: strokes, control_points, weights, equilibrate, "
-            "solver, snap_tolerance_cells");
+            "equilibrium_support, solver, snap_tolerance_cells");
+  EXPECT_EQ(parse_error(R"({"equilibrium_support": "rim", )" + cp + "}"),
+            "case.json: /design/equilibrium_support is \"rim\"; expected \"none\" (free body) or \"simulation\" (the "
+            "vertices the simulation holds)");
 }
 
 TEST(CaseDesign, NonFiniteNumbersAreRefused) {

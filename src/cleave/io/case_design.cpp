@@ -53,7 +53,8 @@ DesignWeights parse_weights(const nlohmann::json& j, const JsonPath& at) {
 }  // namespace
 
 StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at) {
-  json_allow_keys(design, at, {"strokes", "control_points", "weights", "equilibrate", "solver", "snap_tolerance_cells"});
+  json_allow_keys(design, at, {"strokes", "control_points", "weights", "equilibrate", "equilibrium_support", "solver",
+                                  "snap_tolerance_cells"});
   StressDesign d;
   if (const nlohmann::json* strokes = json_find(design, "strokes")) {
     if (!strokes->is_array()) json_error(at / "strokes", *strokes, "an array of strokes {\"points\": [[x, y, z], ...]}");
@@ -70,6 +71,16 @@ StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at)
   if (const nlohmann::json* weights = json_find(design, "weights")) d.weights = parse_weights(*weights, at / "weights");
   if (const nlohmann::json* equilibrate = json_find(design, "equilibrate"))
     d.equilibration = json_bool(*equilibrate, at / "equilibrate") ? Equilibration::growth : Equilibration::none;
+  if (const nlohmann::json* support = json_find(design, "equilibrium_support")) {
+    const std::string name = support->is_string() ? support->get<std::string>() : std::string();
+    if (name == "none") {
+      d.support = EquilibriumSupport::none;
+    } else if (name == "simulation") {
+      d.support = EquilibriumSupport::simulation;
+    } else {
+      json_error(at / "equilibrium_support", *support, "\"none\" (free body) or \"simulation\" (the vertices the simulation holds)");
+    }
+  }
   if (const nlohmann::json* solver = json_find(design, "solver")) {
     const std::string name = solver->is_string() ? solver->get<std::string>() : std::string();
     if (name == "default") {

@@ -3,11 +3,14 @@
 // stress/stress_designer.hpp). A design adds the cell fields langer_direction, normal_direction
 // (unit vectors) and eigenvalues (Langer, cross, normal in Pa), writes streamlines.vtp when
 // output.streamlines is on, and reports summary["design"]: the relative equilibrium residual
-// before and after equilibration and the time of each step.
+// before and after equilibration and the time of each step. With "equilibrium_support":
+// "simulation" the vertices held by the "simulation" section are left out of the equilibrium.
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/core/units.hpp"
+#include "cleave/cut/surface_side_vertices.hpp"
+#include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/io/case_design.hpp"
 #include "cleave/io/case_mechanics.hpp"
 #include "cleave/io/vtp_writer.hpp"
@@ -34,7 +37,28 @@ DataArray eigenvalue_array(const std::vector<Vec3>& eigenvalues_kPa) {
   return a;
 }
 
-void run_design(RunContext& ctx, const StressDesign& design) {
+/// The vertices that the case's "simulation" section holds (boxes and surfaces), on the uncut model.
+std::vector<VertexId> simulation_held_vertices(const RunContext& ctx) {
+  const SimulationSettings s = parse_simulation_settings(ctx.case_file);
+  const LinkedVolume& volume = ctx.model.volume;
+  std::vector<std::uint8_t> held(static_cast<std::size_t>(volume.vertex_count()), 0);
+  for (const FixedBox& box : s.fixed_boxes)
+    for (const VertexId v : vertices_in_box(volume, box.lo_mm, box.hi_mm)) held[static_cast<std::size_t>(v)] = 1;
+  if (!s.fixed_surfaces.empty()) {
+    const BodySurface surface(ctx.model);
+    for (const FixedSurface side : s.fixed_surfaces) {
+      const SurfaceSide which = side == FixedSurface::inner ? SurfaceSide::inner : SurfaceSide::all;
+      for (const VertexId v : surface_side_vertices(surface, which)) held[static_cast<std::size_t>(v)] = 1;
+    }
+  }
+  std::vector<VertexId> out;
+  for (VertexId v = 0; v < volume.vertex_count(); ++v)
+    if (held[static_cast<std::size_t>(v)]) out.push_back(v);
+  return out;
+}
+
+void run_design(RunContext& ctx, StressDesign design) {
+  if (design.support == EquilibriumSupport::simulation) design.held_vertices = simulation_held_vertices(ctx);
   DesignResult result;
   try {
     result = design_residual_stress(ctx.model, design);
@@ -51,6 +75,8 @@ void run_design(RunContext& ctx, const StressDesign& design) {
       {"control_points", design.control_points.size()},
       {"solver", design.solver == EigenvalueSolver::cholesky ? "default" : "paper-cg"},
       {"equilibrated", design.equilibration == Equilibration::growth},
+      {"equilibrium_support", design.support == EquilibriumSupport::simulation ? "simulation" : "none"},
+      {"held_vertices", design.held_vertices.size()},
       {"equilibrium_residual_designed", result.residual_designed},
       {"equilibrium_residual_final", result.residual_final},
       {"equilibrium_residual_definition", "||T sigma|| / (||T||_2 ||sigma||) over all vertices, ||T||_2 by power iteration"},

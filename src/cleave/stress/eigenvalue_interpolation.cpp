@@ -50,8 +50,9 @@ CgOutcome plain_conjugate_gradient(const Eigen::SparseMatrix<double>& a, const V
 
 }  // namespace
 
-EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights)
-    : volume_(volume), weights_(weights) {
+EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights,
+                                               std::vector<VertexId> held_vertices)
+    : volume_(volume), weights_(weights), held_vertices_(std::move(held_vertices)) {
   const Eigen::SparseMatrix<double> l = cell_laplacian(volume);
   const Eigen::SparseMatrix<double> ltl = Eigen::SparseMatrix<double>(l.transpose()) * l;
   std::vector<Eigen::Triplet<double>> entries;
@@ -72,7 +73,9 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
   Eigen::SparseMatrix<double> system = smoothness_;
   if (weights_.equilibrium > 0.0) {
     const double h = volume_.grid().cell_size_mm;
-    const Eigen::SparseMatrix<double> g = eigenvalue_divergence_matrix(volume_, frames);
+    SparseMatrix g_rows = eigenvalue_divergence_matrix(volume_, frames);
+    drop_held_vertex_rows(g_rows, held_vertices_);
+    const Eigen::SparseMatrix<double> g = g_rows;
     const Eigen::SparseMatrix<double> gtg = Eigen::SparseMatrix<double>(g.transpose()) * g;
     system += (weights_.equilibrium / (h * h * h * h)) * gtg;
   }
@@ -96,8 +99,16 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
   EigenvalueSolution solution;
   Vector x;
   if (solver == EigenvalueSolver::cholesky) {
-    cholesky_.factorize(system);
-    x = cholesky_.solve_refined(system, rhs);
+    Eigen::MatrixXd start = Eigen::MatrixXd::Zero(n, 1);
+    if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)
+      for (std::size_t c = 0; c < warm_start.size(); ++c) start.block<3, 1>(3 * static_cast<Eigen::Index>(c), 0) = warm_start[c];
+    if (cholesky_.solve_with_current_factor(system, rhs, start, kReuseTolerance, kMaxReuseIterations)) {
+      x = start.col(0);
+    } else {
+      cholesky_.factorize(system);
+      ++factorizations_;
+      x = cholesky_.solve_refined(system, rhs);
+    }
   } else {
     x = Vector::Zero(n);
     if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)

@@ -8,8 +8,10 @@
 //   EigenvalueInterpolator interp(volume, weights);                // L^T L (x) I3 once per topology
 //   EigenvalueSolution s = interp.solve(frames, targets, EigenvalueSolver::cholesky, warm_start);
 //
-// Solvers: `cholesky` (default): CHOLMOD supernodal Cholesky; the symbolic analysis is reused
-// between calls because the pattern of A^T A depends only on the topology. `paper_cg`: the
+// Solvers: `cholesky` (default): CHOLMOD supernodal Cholesky; the factor is kept between calls
+// (the pattern of A^T A depends only on the topology): after an edit it preconditions CG on the
+// new system from `warm_start`, and the new system is factorized only when that CG needs more
+// than kMaxReuseIterations. `paper_cg`: the
 // paper's plain CG on A^T A (one thread, no preconditioner), started from `warm_start` when it
 // has the right size, to relative residual 1e-12; ComputeError when it does not get there.
 #include <vector>
@@ -30,15 +32,22 @@ struct EigenvalueSolution {
 
 class EigenvalueInterpolator {
  public:
-  EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights);
+  /// `held_vertices`: no eq. 6 rows there (they carry reactions); empty = free body.
+  EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights, std::vector<VertexId> held_vertices = {});
   EigenvalueSolution solve(const std::vector<DirectionFrame>& frames, const std::vector<EigenvalueTarget>& targets,
                            EigenvalueSolver solver, const std::vector<Vec3>& warm_start = {});
+  static constexpr double kReuseTolerance = 1e-13;  ///< relative residual of the CG with the kept factor
+  static constexpr int kMaxReuseIterations = 40;
+  /// Numeric factorizations done so far by the `cholesky` solver.
+  int factorizations() const { return factorizations_; }
 
  private:
   const LinkedVolume& volume_;
   DesignWeights weights_;
+  std::vector<VertexId> held_vertices_;
   Eigen::SparseMatrix<double> smoothness_;  ///< w_L (L^T L) (x) I3, ColMajor
   SparseCholesky cholesky_;
+  int factorizations_ = 0;
 };
 
 }  // namespace cleave

@@ -6,16 +6,27 @@
 // With the one-point (cell-centre) strain matrix Bc of each cube, T^e = V Bc^T exactly (the
 // trilinear B averages to its centre value). Solving
 //   Kc u = -T sigma_d,   Kc = sum over cells of V Bc^T D Bc    (D of the cell's material)
-// and setting sigma = sigma_d + D Bc u gives T sigma = T sigma_d + Kc u = 0. Kc is singular
-// (rigid and hourglass modes) but the right-hand side lies in its range, and those modes do not
-// change D Bc u. The solve is sparse Cholesky of Kc + eps I (eps = 1e-6 of the mean diagonal)
-// used in iterative refinement until ||T sigma|| <= 1e-12 ||T sigma_d|| (or 100 steps).
+// and setting sigma = sigma_d + D Bc u gives T sigma = T sigma_d + Kc u = 0.
+//
+// Why this needs care (issue 4): Kc is singular far beyond the rigid modes. One-point quadrature
+// has exact global hourglass modes (u_x = f(i) (-1)^(j+k) and its permutations, for any f), and
+// thin shells such as the abdomen (2 to 4 cells thick) have bending modes whose eigenvalues are
+// ~1e-6 of the mean diagonal. The right-hand side lies in the range of Kc, and the null modes do
+// not change D Bc u, but a stationary refinement with a shifted factor stalls on the soft modes
+// (the old code: 4.6e-7 after 100 steps on the abdomen). Here the factor of Kc + eps I
+// (eps = 1e-8 of the mean diagonal, computed once per topology) preconditions conjugate
+// gradients on Kc itself: the few eigenvalues of the preconditioned operator that are not close
+// to 1 (soft and near-hourglass modes) are what CG removes in a handful of iterations (9 on the
+// abdomen to 4e-12). The best iterate is kept, since rounding in the null space makes CG drift
+// after convergence.
 // Consequences: the uncut, unsupported body does not move under sigma, and the volume average of
 // sigma is exactly zero (Hoger's theorem, section 3.1), since T sigma = 0 for a field on cubes
 // implies sum_c V sigma_c = 0.
 //
-//   EquilibrationResult r = equilibrate_stress(model, designed_kPa);
+//   StressEquilibrator eq(model);                 // Kc and its factor, once per topology
+//   EquilibrationResult r = eq.equilibrate(designed_kPa);   // per edit, warm-started
 //   r.stress_kPa  // per cell, Voigt
+#include <memory>
 #include <span>
 #include <vector>
 
@@ -25,12 +36,33 @@ namespace cleave {
 
 struct EquilibrationResult {
   std::vector<Vec6> stress_kPa;         ///< self-balanced field, one per cell
-  double force_reduction = 0;           ///< ||T sigma|| / ||T sigma_d|| reached (0 when sigma_d was balanced)
-  int refinement_steps = 0;
+  double force_reduction = 0;           ///< ||T sigma|| / ||T sigma_d|| over free vertices (0 when sigma_d was balanced)
+  int refinement_steps = 0;             ///< preconditioned CG iterations
 };
 
-/// Throws InputError when `designed_kPa` has the wrong size or non-finite values; ComputeError
-/// when the refinement does not reach 1e-10 (never returns NaN).
-EquilibrationResult equilibrate_stress(const TissueModel& model, std::span<const Vec6> designed_kPa);
+class StressEquilibrator {
+ public:
+  /// Assembles Kc and factorizes Kc + eps I. The model must outlive the equilibrator and keep
+  /// its topology and materials. `held_vertices` (Gamma_D) are held at rest: T sigma = 0 is
+  /// imposed at the other vertices only, the held ones carry the reactions. InputError for ids
+  /// out of range.
+  explicit StressEquilibrator(const TissueModel& model, std::span<const VertexId> held_vertices = {});
+  ~StressEquilibrator();
+  StressEquilibrator(StressEquilibrator&&) noexcept;
+  StressEquilibrator& operator=(StressEquilibrator&&) noexcept;
+
+  /// Throws InputError when `designed_kPa` has the wrong size or non-finite values; ComputeError
+  /// when ||T sigma|| / ||T sigma_d|| stays above 1e-10 (never returns NaN). Starts from the
+  /// displacement of the previous call (a small edit needs few iterations).
+  EquilibrationResult equilibrate(std::span<const Vec6> designed_kPa);
+
+ private:
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
+/// One-shot equilibration (a StressEquilibrator used once).
+EquilibrationResult equilibrate_stress(const TissueModel& model, std::span<const Vec6> designed_kPa,
+                                       std::span<const VertexId> held_vertices = {});
 
 }  // namespace cleave

@@ -30,6 +30,10 @@ struct EquilibriumNorm {
   double spectral_norm_mm2 = 0;  ///< estimate of the largest singular value of T
 };
 
+/// Zeroes the rows of `held_vertices` (rows 3 v + a) of a matrix with 3 n_v rows, so that the
+/// operator only measures forces at free vertices (paper eq. 2 holds on Gamma_N only).
+void drop_held_vertex_rows(SparseMatrix& t, std::span<const VertexId> held_vertices);
+
 /// Power iteration (a fixed number of steps from a deterministic start) on T^T T.
 EquilibriumNorm equilibrium_norm(const SparseMatrix& t);
 

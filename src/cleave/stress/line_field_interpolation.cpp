@@ -6,11 +6,6 @@
 #include "cleave/stress/cell_laplacian.hpp"
 
 namespace cleave {
-namespace {
-
-
-}  // namespace
-
 LineFieldInterpolator::LineFieldInterpolator(const LinkedVolume& volume, const DesignWeights& weights)
     : volume_(volume), weights_(weights), cell_count_(volume.cell_count()) {
   const Eigen::SparseMatrix<double> l = cell_laplacian(volume);
@@ -33,8 +28,14 @@ std::vector<Mat3> LineFieldInterpolator::interpolate(const std::vector<LineTarge
   const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
   for (CellId c = 0; c < cell_count_; ++c)
     if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // piece without targets -> 0
-  cholesky_.factorize(system);
-  const Eigen::MatrixXd x = cholesky_.solve_refined(system, rhs);
+  system.makeCompressed();
+  Eigen::MatrixXd x = previous_;
+  if (!cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
+    cholesky_.factorize(system);
+    ++factorizations_;
+    x = cholesky_.solve_refined(system, rhs);
+  }
+  previous_ = x;
   std::vector<Mat3> field(static_cast<std::size_t>(cell_count_));
   for (CellId c = 0; c < cell_count_; ++c) field[static_cast<std::size_t>(c)] = from_voigt(x.row(c).transpose());
   return field;

@@ -9,6 +9,10 @@
 //
 //   LineFieldInterpolator interp(volume, weights);          // L^T L once per topology
 //   std::vector<Mat3> x = interp.interpolate(targets);      // numeric factorization + 6 solves
+//   x = interp.interpolate(edited_targets);                 // no factorization: CG preconditioned
+//                                                           // by the kept factor, from the last x
+// After an edit the kept factor (of the first system) preconditions CG on the new system; only
+// when CG needs more than kMaxReuseIterations is the new system factorized.
 #include <vector>
 
 #include "cleave/grid/linked_volume.hpp"
@@ -23,6 +27,10 @@ class LineFieldInterpolator {
   LineFieldInterpolator(const LinkedVolume& volume, const DesignWeights& weights);
   /// One interpolated tensor per cell. Targets must name cells of the volume (InputError otherwise).
   std::vector<Mat3> interpolate(const std::vector<LineTarget>& targets);
+  static constexpr double kReuseTolerance = 1e-13;  ///< relative residual of the CG with the kept factor
+  static constexpr int kMaxReuseIterations = 40;
+  /// Numeric factorizations done so far (1 after the first call when edits reuse the factor).
+  int factorizations() const { return factorizations_; }
 
  private:
   const LinkedVolume& volume_;
@@ -30,6 +38,8 @@ class LineFieldInterpolator {
   DesignWeights weights_;
   CellId cell_count_ = 0;
   SparseCholesky cholesky_;
+  Eigen::MatrixXd previous_;  ///< last solution (n_c x 6), CG start after an edit
+  int factorizations_ = 0;
 };
 
 }  // namespace cleave

@@ -58,6 +58,43 @@ Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>&
   return x;
 }
 
+bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b,
+                                               Eigen::MatrixXd& x, double relative_tolerance, int max_iterations) const {
+  if (!impl_->analyzed || !impl_->same_pattern(a) || x.rows() != b.rows() || x.cols() != b.cols()) return false;
+  for (Eigen::Index col = 0; col < b.cols(); ++col) {
+    const double b_norm = b.col(col).norm();
+    if (b_norm == 0.0) {
+      x.col(col).setZero();
+      continue;
+    }
+    Eigen::VectorXd xc = x.col(col);
+    Eigen::VectorXd r = b.col(col) - a * xc;
+    if (r.norm() <= relative_tolerance * b_norm) continue;
+    Eigen::VectorXd z = impl_->llt.solve(r);
+    Eigen::VectorXd p = z;
+    double rz = r.dot(z);
+    bool converged = false;
+    for (int it = 0; it < max_iterations && !converged; ++it) {
+      const Eigen::VectorXd ap = a * p;
+      const double curvature = p.dot(ap);
+      if (!(curvature > 0.0) || !(rz > 0.0)) return false;
+      const double alpha = rz / curvature;
+      xc += alpha * p;
+      r -= alpha * ap;
+      converged = r.norm() <= relative_tolerance * b_norm;
+      if (converged) break;
+      z = impl_->llt.solve(r);
+      const double rz_next = r.dot(z);
+      p = z + (rz_next / rz) * p;
+      rz = rz_next;
+    }
+    if (!converged || !xc.allFinite()) return false;
+    if ((b.col(col) - a * xc).norm() > 10.0 * relative_tolerance * b_norm) return false;  // recurrence drifted
+    x.col(col) = xc;
+  }
+  return true;
+}
+
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   Eigen::MatrixXd x = impl_->llt.solve(b);
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())

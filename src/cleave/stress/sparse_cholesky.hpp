@@ -27,6 +27,15 @@ class SparseCholesky {
   /// matrix): the design systems (L^T L, condition ~ n^2) lose digits in a plain solve.
   Eigen::MatrixXd solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const;
   static constexpr int kRefinementSteps = 2;
+  /// Solves a x = b for a matrix `a` with the pattern of the factorized one but other values
+  /// (a design edit), by conjugate gradients preconditioned with the current factor, column by
+  /// column, starting from x (the previous solution). An edit that changes a few constraint rows
+  /// is a low-rank change, so CG needs about as many iterations as the rank of the change and no
+  /// new factorization is needed. Returns true when every column reached
+  /// ||b - a x|| <= relative_tolerance ||b|| within max_iterations; false (x unspecified) when
+  /// there is no factor, the pattern differs, or CG did not get there: then factorize(a).
+  bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+                                 double relative_tolerance, int max_iterations) const;
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 

@@ -41,6 +41,14 @@ enum class EigenvalueSolver {
   paper_cg,  ///< reference: the paper's plain conjugate gradients on A^T A, one thread
 };
 
+/// Where the equilibrium equations hold (paper eqs. 1, 2: sigma n = 0 only on the free surface
+/// Gamma_N). The held vertices (Gamma_D, e.g. the rim of the demo's abdominal wall) may carry
+/// reactions, so the eq. 6 rows and the exact equilibration skip them.
+enum class EquilibriumSupport {
+  none,        ///< free body: equilibrium at every vertex (Hoger: mean stress 0)
+  simulation,  ///< the vertices that the case's "simulation" section holds (stage_residual_stress)
+};
+
 /// Whether the designed field is made exactly self-balanced afterwards (equilibrate_stress.hpp).
 enum class Equilibration {
   none,    ///< keep the least-squares design as it is
@@ -53,6 +61,10 @@ struct StressDesign {
   DesignWeights weights;
   EigenvalueSolver solver = EigenvalueSolver::cholesky;
   Equilibration equilibration = Equilibration::growth;
+  EquilibriumSupport support = EquilibriumSupport::none;
+  /// Held vertices (uncut model's vertex ids) where equilibrium is not imposed; empty = free body.
+  /// Filled from the simulation section when support == simulation; may be set directly.
+  std::vector<VertexId> held_vertices;
   /// Surface points farther than this many cell sizes from the body surface are refused.
   double snap_tolerance_cells = 2.0;
 };

@@ -41,19 +41,23 @@ bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignSt
 }  // namespace
 
 struct StressDesigner::Operators {
-  Operators(const TissueModel& model, const DesignWeights& weights)
+  Operators(const TissueModel& model, const DesignWeights& weights, const std::vector<VertexId>& held)
       : langer(model.volume, weights),
-        eigenvalues(model.volume, weights),
+        eigenvalues(model.volume, weights, held),
         divergence(stress_divergence_matrix(model.volume)),
-        norm(equilibrium_norm(divergence)) {
+        held_vertices(held) {
+    drop_held_vertex_rows(divergence, held);
+    norm = equilibrium_norm(divergence);
     LineFieldInterpolator normal_interp(model.volume, weights);
     normal_tensors = normal_interp.interpolate(surface_normal_targets(model));
   }
   LineFieldInterpolator langer;
   EigenvalueInterpolator eigenvalues;
-  SparseMatrix divergence;
+  SparseMatrix divergence;  ///< T, rows of held vertices dropped
   EquilibriumNorm norm;
+  std::vector<VertexId> held_vertices;
   std::vector<Mat3> normal_tensors;
+  std::unique_ptr<StressEquilibrator> equilibrator;  ///< built at the first equilibration (Kc factor)
 };
 
 StressDesigner::StressDesigner(const TissueModel& model, StressDesign design) : model_(model) {
@@ -64,7 +68,7 @@ StressDesigner::StressDesigner(const TissueModel& model, StressDesign design) : 
   const double tolerance_mm = design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
   stroke_line_targets(model, design.strokes, tolerance_mm);
   control_point_targets(model, design.control_points, tolerance_mm);
-  ops_ = std::make_unique<Operators>(model, design.weights);
+  ops_ = std::make_unique<Operators>(model, design.weights, design.held_vertices);
   DesignResult next;
   update_directions(design, next);
   update_eigenvalues(design, next);
@@ -99,7 +103,8 @@ void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
   out.residual_designed = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.designed_kPa);
   const auto start = std::chrono::steady_clock::now();
   if (design.equilibration == Equilibration::growth) {
-    out.stress_kPa = equilibrate_stress(model_, out.designed_kPa).stress_kPa;
+    if (!ops_->equilibrator) ops_->equilibrator = std::make_unique<StressEquilibrator>(model_, ops_->held_vertices);
+    out.stress_kPa = ops_->equilibrator->equilibrate(out.designed_kPa).stress_kPa;
   } else {
     out.stress_kPa = out.designed_kPa;
   }
@@ -111,8 +116,8 @@ void StressDesigner::set_design(StressDesign design) {
   const DesignWeights& a = design.weights;
   const DesignWeights& b = design_.weights;
   if (a.laplacian != b.laplacian || a.constraint != b.constraint || a.equilibrium != b.equilibrium ||
-      design.snap_tolerance_cells != design_.snap_tolerance_cells)
-    throw InputError("design weights or snap tolerance changed; expected the same (build a new StressDesigner for new weights)");
+      design.snap_tolerance_cells != design_.snap_tolerance_cells || design.held_vertices != design_.held_vertices)
+    throw InputError("design weights, snap tolerance or held vertices changed; expected the same (build a new StressDesigner)");
   // Work on a copy: a failing edit leaves the designer as it was.
   DesignResult next = result_;
   next.timings = {};

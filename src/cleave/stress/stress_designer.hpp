@@ -37,7 +37,7 @@ struct DesignResult {
   std::vector<Vec3> eigenvalues_kPa;     ///< per cell: Langer, cross, normal (of the design, before equilibration)
   std::vector<Vec6> designed_kPa;        ///< sigma from frames and eigenvalues (eq. 4)
   std::vector<Vec6> stress_kPa;          ///< the result: designed_kPa, equilibrated when enabled
-  double residual_designed = 0;          ///< ||T sigma|| / (||T||_2 ||sigma||) of designed_kPa
+  double residual_designed = 0;          ///< ||T sigma|| / (||T||_2 ||sigma||) of designed_kPa (free vertices)
   double residual_final = 0;             ///< the same of stress_kPa
   int eigenvalue_iterations = 0;         ///< paper CG iterations of the last solve (0 for Cholesky)
   DesignTimings timings;
