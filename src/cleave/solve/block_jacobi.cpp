@@ -29,9 +29,9 @@ Mat3 inverse_or_identity(const Mat3& block) {
 
 }  // namespace
 
-std::vector<Mat3f> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
+std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
   const auto vertices = static_cast<std::size_t>(a.block_rows());
-  std::vector<Mat3f> out(vertices);
+  std::vector<Mat3> out(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t v = range.begin(); v < range.end(); ++v) {
       const auto first = a.column.begin() + a.row_start[v];
@@ -40,7 +40,7 @@ std::vector<Mat3f> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
       Mat3 block = Mat3::Zero();
       if (found != last && *found == static_cast<std::int32_t>(v))
         block = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * (found - a.column.begin()));
-      out[v] = inverse_or_identity(block).cast<float>();
+      out[v] = inverse_or_identity(block);
     }
   });
   return out;

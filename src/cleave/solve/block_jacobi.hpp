@@ -25,7 +25,7 @@ class BlockJacobi final : public Preconditioner {
 
 BlockJacobi block_jacobi(const SparseMatrix& a);
 
-/// The same inverse blocks, from a block CSR matrix, in single precision (the smoother's D^-1).
-std::vector<Mat3f> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a);
+/// The same inverse blocks, from a block CSR matrix.
+std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a);
 
 }  // namespace cleave

@@ -122,16 +122,22 @@ void residual(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatr
   });
 }
 
-void jacobi_residual(const BlockSparseMatrix<float>& a, const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b,
-                     const Eigen::VectorXf& x, Eigen::VectorXf& z) {
+template <typename Scalar>
+void jacobi_residual(const BlockSparseMatrix<Scalar>& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                     const typename BlockSparseMatrix<Scalar>::VectorType& b, const typename BlockSparseMatrix<Scalar>::VectorType& x,
+                     typename BlockSparseMatrix<Scalar>::VectorType& z) {
   z.resize(a.rows());
-  const float* xp = x.data();
+  const Scalar* xp = x.data();
   for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
-    const Eigen::Vector3f r = b.segment<3>(3 * v) - row_product(a, xp, v);
-    z.segment<3>(3 * v) = inverse_diagonal[static_cast<std::size_t>(v)] * r;
+    const Eigen::Matrix<Scalar, 3, 1> r = b.template segment<3>(3 * v) - row_product(a, xp, v);
+    z.template segment<3>(3 * v) = inverse_diagonal[static_cast<std::size_t>(v)] * r;
   });
 }
 
+template void jacobi_residual<float>(const BlockSparseMatrix<float>&, const std::vector<Mat3f>&, const Eigen::VectorXf&,
+                                     const Eigen::VectorXf&, Eigen::VectorXf&);
+template void jacobi_residual<double>(const BlockSparseMatrix<double>&, const std::vector<Eigen::Matrix3d>&, const Eigen::VectorXd&,
+                                      const Eigen::VectorXd&, Eigen::VectorXd&);
 template BlockSparseMatrix<float> to_block_sparse<float>(const SparseMatrix&);
 template BlockSparseMatrix<double> to_block_sparse<double>(const SparseMatrix&);
 template void refresh_block_values<float>(const SparseMatrix&, BlockSparseMatrix<float>&);

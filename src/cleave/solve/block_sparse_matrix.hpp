@@ -50,7 +50,9 @@ void residual(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatr
               const typename BlockSparseMatrix<Scalar>::VectorType& x, typename BlockSparseMatrix<Scalar>::VectorType& r);
 
 /// z = D^-1 (b - A x) in one pass, D^-1 given per vertex (block Jacobi).
-void jacobi_residual(const BlockSparseMatrix<float>& a, const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b,
-                     const Eigen::VectorXf& x, Eigen::VectorXf& z);
+template <typename Scalar>
+void jacobi_residual(const BlockSparseMatrix<Scalar>& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                     const typename BlockSparseMatrix<Scalar>::VectorType& b, const typename BlockSparseMatrix<Scalar>::VectorType& x,
+                     typename BlockSparseMatrix<Scalar>::VectorType& z);
 
 }  // namespace cleave

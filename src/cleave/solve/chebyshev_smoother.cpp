@@ -12,14 +12,16 @@ namespace {
 
 constexpr Eigen::Index kEntriesPerTask = 1 << 14;
 
-std::vector<Mat3f> single_precision(const BlockJacobi& d) {
-  std::vector<Mat3f> out(d.inverse_blocks.size());
-  for (std::size_t v = 0; v < out.size(); ++v) out[v] = d.inverse_blocks[v].cast<float>();
+std::vector<Mat3f> single_precision(const std::vector<Mat3>& blocks) {
+  std::vector<Mat3f> out(blocks.size());
+  for (std::size_t v = 0; v < out.size(); ++v) out[v] = blocks[v].cast<float>();
   return out;
 }
 
 /// d = c_d d + c_z z; x += d (or x = d when `assign`), in parallel chunks.
-void update_direction(float c_d, float c_z, const Eigen::VectorXf& z, Eigen::VectorXf& d, Eigen::VectorXf& x, bool assign) {
+template <typename Scalar>
+void update_direction(Scalar c_d, Scalar c_z, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z,
+                      Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& d, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, bool assign) {
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, z.size(), kEntriesPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
     const Eigen::Index n = r.end() - r.begin();
     auto ds = d.segment(r.begin(), n);
@@ -52,23 +54,41 @@ ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const Chebyshev
   const double growth = x.norm();
   if (std::isfinite(growth) && growth > estimate) estimate = growth;
   s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
-  s.inverse_diagonal = single_precision(diagonal);
+  s.set_inverse_diagonal(diagonal.inverse_blocks);
   return s;
 }
 
-void ChebyshevSmoother::smooth_from_zero(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
-                                         ChebyshevWork& work) const {
+void ChebyshevSmoother::set_inverse_diagonal(std::vector<Mat3> inverse) {
+  inverse_diagonal = std::move(inverse);
+  inverse_diagonal_single = single_precision(inverse_diagonal);
+}
+
+template <>
+const std::vector<Mat3f>& ChebyshevSmoother::inverse_blocks<float>() const {
+  return inverse_diagonal_single;
+}
+template <>
+const std::vector<Mat3>& ChebyshevSmoother::inverse_blocks<double>() const {
+  return inverse_diagonal;
+}
+
+template <typename Scalar>
+void ChebyshevSmoother::smooth_from_zero(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                         Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const {
   iterate(a, b, x, work, Start::from_zero);
 }
 
-void ChebyshevSmoother::smooth(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
-                               ChebyshevWork& work) const {
+template <typename Scalar>
+void ChebyshevSmoother::smooth(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const {
   iterate(a, b, x, work, Start::from_x);
 }
 
 // Chebyshev iteration on [lower, upper] (Saad, Iterative Methods, algorithm 12.1) with D^-1.
-void ChebyshevSmoother::iterate(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x,
-                                ChebyshevWork& work, Start start) const {
+template <typename Scalar>
+void ChebyshevSmoother::iterate(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work, Start start) const {
+  const auto& inverse = inverse_blocks<Scalar>();
   const double upper = lambda_max;
   const double lower = lambda_max / options.smoothing_range;
   const double theta = 0.5 * (upper + lower);
@@ -76,7 +96,7 @@ void ChebyshevSmoother::iterate(const BlockSparseMatrix<float>& a, const Eigen::
   const double sigma = theta / delta;
   double rho = 1.0 / sigma;
   const Eigen::Index n = b.size();
-  work.d.resize(n);
+  work.d.setZero(n);
   if (start == Start::from_zero) {
     x.resize(n);
     work.z.resize(n);
@@ -84,22 +104,29 @@ void ChebyshevSmoother::iterate(const BlockSparseMatrix<float>& a, const Eigen::
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, kEntriesPerTask / 3), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t v = r.begin(); v < r.end(); ++v) {
         const auto i = static_cast<Eigen::Index>(3 * v);
-        work.z.segment<3>(i) = inverse_diagonal[v] * b.segment<3>(i);
+        work.z.template segment<3>(i) = inverse[v] * b.template segment<3>(i);
       }
     });
-    work.d.setZero();
-    update_direction(0.0f, static_cast<float>(1.0 / theta), work.z, work.d, x, true);
+    update_direction(Scalar{0}, static_cast<Scalar>(1.0 / theta), work.z, work.d, x, true);
   } else {
-    jacobi_residual(a, inverse_diagonal, b, x, work.z);
-    work.d.setZero();
-    update_direction(0.0f, static_cast<float>(1.0 / theta), work.z, work.d, x, false);
+    jacobi_residual(a, inverse, b, x, work.z);
+    update_direction(Scalar{0}, static_cast<Scalar>(1.0 / theta), work.z, work.d, x, false);
   }
   for (int k = 1; k < options.degree; ++k) {
-    jacobi_residual(a, inverse_diagonal, b, x, work.z);
+    jacobi_residual(a, inverse, b, x, work.z);
     const double rho_next = 1.0 / (2.0 * sigma - rho);
-    update_direction(static_cast<float>(rho_next * rho), static_cast<float>(2.0 * rho_next / delta), work.z, work.d, x, false);
+    update_direction(static_cast<Scalar>(rho_next * rho), static_cast<Scalar>(2.0 * rho_next / delta), work.z, work.d, x, false);
     rho = rho_next;
   }
 }
+
+template void ChebyshevSmoother::smooth_from_zero<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, Eigen::VectorXf&,
+                                                         ChebyshevWork<float>&) const;
+template void ChebyshevSmoother::smooth_from_zero<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, Eigen::VectorXd&,
+                                                          ChebyshevWork<double>&) const;
+template void ChebyshevSmoother::smooth<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, Eigen::VectorXf&,
+                                               ChebyshevWork<float>&) const;
+template void ChebyshevSmoother::smooth<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, Eigen::VectorXd&,
+                                                ChebyshevWork<double>&) const;
 
 }  // namespace cleave

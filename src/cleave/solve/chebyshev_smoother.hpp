@@ -9,9 +9,9 @@
 //   s.smooth_from_zero(blocks, b, x, work);   // x = p(D^-1 A) D^-1 b       (blocks: a in float)
 //   s.smooth(blocks, b, x, work);             // x += p(D^-1 A) D^-1 (b - A x)
 //
-// Smoothing runs in single precision on the block CSR copy of a (block_sparse_matrix.hpp): it is
-// part of a preconditioner, whose rounding the outer double-precision CG absorbs, and it halves
-// the bytes streamed. lambda_max of D^-1 A is estimated by power iteration (double) and enlarged
+// Smoothing runs on the block CSR copy of a (block_sparse_matrix.hpp), in single precision where
+// the multigrid cycle does (half the bytes streamed; the outer double-precision CG absorbs the
+// rounding) or in double. lambda_max of D^-1 A is estimated by power iteration (double) and enlarged
 // by a safety factor.
 #include "cleave/solve/block_jacobi.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
@@ -25,23 +25,35 @@ struct ChebyshevOptions {
   double lambda_safety_factor = 1.15;  ///< multiplies the power-iteration estimate
 };
 
+template <typename Scalar>
 struct ChebyshevWork {
-  Eigen::VectorXf d, z;
+  Eigen::Matrix<Scalar, Eigen::Dynamic, 1> d, z;
 };
 
 class ChebyshevSmoother {
  public:
-  std::vector<Mat3f> inverse_diagonal;  ///< per vertex: D^-1 block (single precision)
+  std::vector<Mat3> inverse_diagonal;          ///< per vertex: D^-1 block
+  std::vector<Mat3f> inverse_diagonal_single;  ///< the same in single precision
   double lambda_max = 1;  ///< upper end of the damped interval (safety factor included)
   ChebyshevOptions options;
 
-  void smooth_from_zero(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work) const;
-  void smooth(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work) const;
+  /// New D^-1 (new values of the same matrix); lambda_max is kept.
+  void set_inverse_diagonal(std::vector<Mat3> inverse);
+
+  template <typename Scalar>
+  void smooth_from_zero(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                        Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const;
+  template <typename Scalar>
+  void smooth(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const;
 
  private:
   enum class Start { from_zero, from_x };
-  void iterate(const BlockSparseMatrix<float>& a, const Eigen::VectorXf& b, Eigen::VectorXf& x, ChebyshevWork& work,
-               Start start) const;
+  template <typename Scalar>
+  void iterate(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work, Start start) const;
+  template <typename Scalar>
+  const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_blocks() const;
 };
 
 ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const ChebyshevOptions& options = {});

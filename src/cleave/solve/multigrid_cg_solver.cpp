@@ -12,6 +12,10 @@
 namespace cleave {
 namespace {
 
+/// CG with the single-precision cycle needs 10 to 30 iterations where it works; one that has not
+/// converged after this many goes on with the double-precision cycle.
+constexpr int kSinglePrecisionMaxIterations = 100;
+
 class MultigridCgSolver final : public LinearSolver {
  public:
   MultigridCgSolver(const SolveSettings& settings, const MultigridOptions& options) : settings_(settings), options_(options) {}
@@ -44,7 +48,22 @@ class MultigridCgSolver final : public LinearSolver {
   SolveReport solve(const Vector& b, Vector& x) override {
     if (b.size() != a_.rows())
       throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));
-    const SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_, settings_);
+    SolveReport report;
+    if (preconditioner_.precision() == CyclePrecision::single_precision) {
+      SolveSettings attempt = settings_;
+      attempt.max_iterations = std::min(settings_.max_iterations, kSinglePrecisionMaxIterations);
+      report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+      if (!report.converged && report.iterations < settings_.max_iterations) {
+        // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
+        preconditioner_.use_double_precision(a_blocks_);
+        const int spent = report.iterations;
+        attempt.max_iterations = settings_.max_iterations - spent;
+        report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+        report.iterations += spent;
+      }
+    } else {
+      report = preconditioned_cg(a_blocks_, b, x, preconditioner_, settings_);
+    }
     if (baseline_iterations_ < 0) baseline_iterations_ = report.iterations;
     else if (report.iterations > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
     return report;

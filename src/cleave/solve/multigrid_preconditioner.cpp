@@ -116,9 +116,11 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     grid = std::move(next.coarse);
     m.levels_.push_back(std::move(coarse));
   }
+  m.precision_ = options.precision;
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     m.levels_[l].smoother = make_chebyshev_smoother(m.operator_of(l), options.smoother);
-    m.levels_[l].blocks = to_block_sparse<float>(m.operator_of(l));
+    if (m.precision_ == CyclePrecision::single_precision) m.levels_[l].single.blocks = to_block_sparse<float>(m.operator_of(l));
+    else m.levels_[l].twin.blocks = to_block_sparse<double>(m.operator_of(l));
   }
 
   m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
@@ -132,49 +134,81 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     if (m.coarsest_->ldlt.info() != Eigen::Success)
       throw ComputeError(fmt::format("multigrid: the coarsest level ({} dofs) cannot be factored", coarsest.rows()));
   }
-  for (auto& level : m.levels_) {
-    const Eigen::Index n = level.fixed.size() == 0 ? 0 : static_cast<Eigen::Index>(level.fixed.size());
-    level.rhs.setZero(n);
-    level.solution.setZero(n);
-    level.residual.setZero(n);
-  }
+  if (m.precision_ == CyclePrecision::single_precision) m.allocate_cycle<float>();
+  else m.allocate_cycle<double>();
   return m;
+}
+
+template <typename Scalar>
+void MultigridPreconditioner::allocate_cycle() {
+  for (auto& level : levels_) {
+    const auto n = static_cast<Eigen::Index>(level.fixed.size());
+    const CycleData<Scalar>& data = level.data<Scalar>();
+    data.rhs.setZero(n);
+    data.solution.setZero(n);
+    data.residual.setZero(n);
+  }
+}
+
+void MultigridPreconditioner::use_double_precision(const BlockSparseMatrix<double>& fine) {
+  if (precision_ == CyclePrecision::double_precision) return;
+  precision_ = CyclePrecision::double_precision;
+  for (std::size_t l = 0; l + 1 < levels_.size(); ++l) {
+    levels_[l].single = CycleData<float>();
+    levels_[l].twin.blocks = l == 0 ? fine : to_block_sparse<double>(levels_[l].matrix);
+  }
+  if (levels_.size() > 1) levels_[0].smoother.set_inverse_diagonal(inverse_diagonal_blocks(fine));
+  allocate_cycle<double>();
 }
 
 void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>& a) {
   if (levels_.size() < 2) return;  // a single level: the (older) factorization preconditions
   MultigridLevel& fine = levels_[0];
-  if (a.blocks() != fine.blocks.blocks() || a.block_rows() != fine.blocks.block_rows())
+  if (a.row_start.size() != fine.smoother.inverse_diagonal.size() + 1 ||
+      a.blocks() != (precision_ == CyclePrecision::single_precision ? fine.single.blocks.blocks() : fine.twin.blocks.blocks()))
     throw InputError("multigrid: the refreshed matrix does not have the pattern the levels were built from");
-  fine.smoother.inverse_diagonal = inverse_diagonal_blocks(a);
+  fine.smoother.set_inverse_diagonal(inverse_diagonal_blocks(a));
+  if (precision_ == CyclePrecision::double_precision) {
+    fine.twin.blocks.values = a.values;
+    return;
+  }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.values.size(), std::size_t{1} << 16),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i < range.end(); ++i) fine.blocks.values[i] = static_cast<float>(a.values[i]);
+                      for (std::size_t i = range.begin(); i < range.end(); ++i)
+                        fine.single.blocks.values[i] = static_cast<float>(a.values[i]);
                     });
 }
 
+template <typename Scalar>
 void MultigridPreconditioner::cycle(std::size_t l) const {
   const MultigridLevel& level = levels_[l];
-  const BlockSparseMatrix<float>& a = level.blocks;
+  const CycleData<Scalar>& data = level.data<Scalar>();
   if (l + 1 == levels_.size()) {
-    const Vector rhs = level.rhs.cast<double>();
-    level.solution = coarsest_->ldlt.solve(rhs).cast<float>();
-    if (!level.solution.allFinite()) level.solution.setZero();
+    const Vector rhs = data.rhs.template cast<double>();
+    data.solution = coarsest_->ldlt.solve(rhs).template cast<Scalar>();
+    if (!data.solution.allFinite()) data.solution.setZero();
     return;
   }
-  level.smoother.smooth_from_zero(a, level.rhs, level.solution, level.work);
-  residual(a, level.rhs, level.solution, level.residual);
-  const MultigridLevel& coarse = levels_[l + 1];
-  restrict_to_coarse(level.from_coarser, level.fixed, level.residual, coarse.rhs);
-  cycle(l + 1);
-  prolongate_add(level.from_coarser, level.fixed, coarse.solution, level.solution);
-  level.smoother.smooth(a, level.rhs, level.solution, level.work);
+  const BlockSparseMatrix<Scalar>& a = data.blocks;
+  level.smoother.smooth_from_zero(a, data.rhs, data.solution, data.work);
+  residual(a, data.rhs, data.solution, data.residual);
+  const CycleData<Scalar>& coarse = levels_[l + 1].data<Scalar>();
+  restrict_to_coarse(level.from_coarser, level.fixed, data.residual, coarse.rhs);
+  cycle<Scalar>(l + 1);
+  prolongate_add(level.from_coarser, level.fixed, coarse.solution, data.solution);
+  level.smoother.smooth(a, data.rhs, data.solution, data.work);
 }
 
 void MultigridPreconditioner::apply(const Vector& r, Vector& z) const {
-  levels_[0].rhs = r.cast<float>();
-  cycle(0);
-  z = levels_[0].solution.cast<double>();
+  if (precision_ == CyclePrecision::single_precision) {
+    levels_[0].single.rhs = r.cast<float>();
+    cycle<float>(0);
+    z = levels_[0].single.solution.cast<double>();
+  } else {
+    levels_[0].twin.rhs = r;
+    cycle<double>(0);
+    z = levels_[0].twin.solution;
+  }
 }
 
 }  // namespace cleave

@@ -15,6 +15,7 @@
 // the preconditioner. Throws InputError when the sizes do not match.
 // apply() uses internal work vectors: one apply at a time per object.
 #include <memory>
+#include <type_traits>
 #include <vector>
 
 #include "cleave/solve/block_sparse_matrix.hpp"
@@ -24,11 +25,21 @@
 
 namespace cleave {
 
+/// The arithmetic of the V-cycle (the outer CG is always double).
+enum class CyclePrecision {
+  single_precision,  ///< float operators and vectors: half the bytes; fine where A is well conditioned
+  double_precision,  ///< for ill-conditioned systems (a free piece held by 3-2-1 supports) where
+                     ///< float rounding of A hides its smallest eigenvalues
+};
+
 struct MultigridOptions {
   int coarsest_max_dofs = 2000;          ///< stop coarsening once a level is this small
   double min_coarsening_ratio = 0.85;    ///< stop when a level keeps more than this share of dofs
   int max_levels = 12;
   ChebyshevOptions smoother;
+  /// The cycle's precision at build; multigrid_cg_solver falls back to double when CG with the
+  /// single-precision cycle does not converge.
+  CyclePrecision precision = CyclePrecision::single_precision;
   /// update_values() keeps the coarse levels of an older matrix for at most this many updates
   /// (only the fine level's matrix and block diagonal follow every update) ...
   int max_stale_updates = 16;
@@ -37,17 +48,28 @@ struct MultigridOptions {
   double stale_iteration_growth = 1.3;
 };
 
+/// A level's operator and work vectors in the cycle's precision.
+template <typename Scalar>
+struct CycleData {
+  BlockSparseMatrix<Scalar> blocks;  ///< the level's operator as block CSR (all levels but the coarsest)
+  mutable Eigen::Matrix<Scalar, Eigen::Dynamic, 1> rhs, solution, residual;
+  mutable ChebyshevWork<Scalar> work;
+};
+
 /// One level: its operator, smoother, and the prolongation from the next coarser level.
-/// The cycle runs in single precision on `blocks` (block CSR, half the bytes of scalar CSR in
-/// double); the outer CG (double) absorbs the rounding.
 struct MultigridLevel {
   SparseMatrix matrix;              ///< coarse levels only; level 0 uses the referenced fine matrix
-  BlockSparseMatrix<float> blocks;  ///< the level's operator in float (all levels but the coarsest)
   std::vector<std::uint8_t> fixed;  ///< per dof: identity row
   ChebyshevSmoother smoother;
   Prolongation from_coarser;        ///< empty on the coarsest level
-  mutable Eigen::VectorXf rhs, solution, residual;
-  mutable ChebyshevWork work;
+  CycleData<float> single;          ///< filled when the cycle runs in single precision
+  CycleData<double> twin;           ///< filled when it runs in double precision
+
+  template <typename Scalar>
+  const CycleData<Scalar>& data() const {
+    if constexpr (std::is_same_v<Scalar, float>) return single;
+    else return twin;
+  }
 };
 
 class MultigridPreconditioner final : public Preconditioner {
@@ -58,6 +80,11 @@ class MultigridPreconditioner final : public Preconditioner {
   MultigridPreconditioner& operator=(MultigridPreconditioner&&) noexcept;
 
   void apply(const Vector& r, Vector& z) const override;
+
+  CyclePrecision precision() const { return precision_; }
+  /// Switches the cycle to double precision; `fine` is the current fine matrix (block CSR, the
+  /// pattern built from, possibly newer values).
+  void use_double_precision(const BlockSparseMatrix<double>& fine);
 
   /// Gives the fine level's smoother the values of `a` (the matrix built from, as block CSR,
   /// with new values: same pattern and fixed dofs) and their block diagonal; the coarse levels,
@@ -74,11 +101,15 @@ class MultigridPreconditioner final : public Preconditioner {
   friend MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume,
                                                  const MultigridOptions& options);
   struct CoarsestSolver;
+  template <typename Scalar>
   void cycle(std::size_t level) const;
+  template <typename Scalar>
+  void allocate_cycle();
 
   const SparseMatrix* fine_ = nullptr;
   std::vector<MultigridLevel> levels_;
   std::unique_ptr<CoarsestSolver> coarsest_;
+  CyclePrecision precision_ = CyclePrecision::single_precision;
 };
 
 MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {});
