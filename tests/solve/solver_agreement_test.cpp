@@ -3,9 +3,11 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstdio>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/linear_solver.hpp"
+#include "cleave/solve/multigrid_cg_solver.hpp"
 #include "solve_test_systems.hpp"
 
 namespace cleave {
@@ -131,6 +133,38 @@ TEST(SolverFactory, NamesRoundTripAndUnknownNamesAreListed) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "unknown solver 'gmres'; expected one of multigrid, eigen-cg, cholmod");
   }
+}
+
+}  // namespace
+}  // namespace cleave
+
+namespace cleave {
+namespace {
+
+// The multigrid cycle in single precision (the default) and in double precision (the fallback
+// for ill-conditioned systems) give the same solution to the solver tolerance, with about as
+// many iterations: the outer double CG absorbs the float rounding of a well-posed system.
+TEST(SolverAgreement, SingleAndDoublePrecisionCyclesAgree) {
+  TissueModel model = test::make_box({32, 16, 4}, 1.0);  // 8,400 dofs: four levels
+  test::cut_across_middle(model, 10);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::both_ends);
+  std::vector<Vector> results;
+  std::vector<int> iterations;
+  for (const CyclePrecision precision : {CyclePrecision::single_precision, CyclePrecision::double_precision}) {
+    MultigridOptions options;
+    options.precision = precision;
+    auto solver = make_multigrid_cg_solver(tight(), options);
+    solver->setup(s.a, model.volume);
+    Vector x = Vector::Zero(s.b.size());
+    const SolveReport r = solver->solve(s.b, x);
+    EXPECT_TRUE(r.converged);
+    EXPECT_LE(r.relative_residual, kTightTolerance);
+    results.push_back(x);
+    iterations.push_back(r.iterations);
+  }
+  std::printf("partially cut plate: %d iterations with the float cycle, %d with the double cycle\n", iterations[0], iterations[1]);
+  EXPECT_LT((results[0] - results[1]).norm() / results[1].norm(), kAgreement);
+  EXPECT_LE(iterations[0], iterations[1] + 3);
 }
 
 }  // namespace
