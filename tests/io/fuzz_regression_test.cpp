@@ -84,6 +84,13 @@ TEST(FuzzRegressions, PlyWithoutEndHeaderIsRefusedBeforeAssimp) {
             file.string() + ": not a PLY file (expected 'ply' first and an 'end_header' line)");
 }
 
+// fuzz_mesh_ply: a header with unknown lines ("propert", "y double motz") made assimp's PLY
+// parser loop for more than 25 s.
+TEST(FuzzRegressions, PlyHeaderWithUnknownLinesIsRefusedBeforeAssimp) {
+  const auto file = kRegressions / "mesh_ply" / "unknown_header_lines_hang.ply";
+  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }), file.string() + ": malformed PLY header line 'propert\xEF\xBF\xBDy double motz'");
+}
+
 bool is_valid_utf8(const std::string& s) {
   try {
     (void)nlohmann::json(s).dump();

@@ -9,6 +9,7 @@
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/atomic_file.hpp"
+#include "cleave/io/json_fields.hpp"
 
 namespace cleave {
 namespace {
@@ -50,7 +51,7 @@ void require_well_formed_ply(const std::filesystem::path& file) {
   if (data.rfind("ply", 0) != 0 || header_end == std::string::npos)
     throw InputError(fmt::format("{}: not a PLY file (expected 'ply' first and an 'end_header' line)", f));
   const auto malformed = [&](const std::string& line) {
-    throw InputError(fmt::format("{}: malformed PLY header line '{}'", f, line.substr(0, 80)));
+    throw InputError(fmt::format("{}: malformed PLY header line '{}'", f, utf8_prefix(utf8_sanitized(line), 80)));
   };
   std::size_t pos = data.find('\n', header_end);
   pos = pos == std::string::npos ? data.size() : pos + 1;
@@ -61,7 +62,9 @@ void require_well_formed_ply(const std::filesystem::path& file) {
     std::istringstream words(line);
     std::string keyword;
     words >> keyword;
-    if (keyword == "format") {
+    if (keyword.empty() || keyword == "ply" || keyword == "comment" || keyword == "obj_info") {
+      continue;
+    } else if (keyword == "format") {
       std::string format;
       words >> format;
       binary = format == "binary_little_endian" || format == "binary_big_endian";
@@ -89,7 +92,20 @@ void require_well_formed_ply(const std::filesystem::path& file) {
         if (p.bytes == 0) malformed(line);
       }
       elements.back().properties.push_back(p);
+    } else {
+      malformed(line);  // assimp loops on some unknown lines (a hang found by fuzz_mesh_ply)
     }
+  }
+  // Every item takes at least one byte in either encoding: a count beyond the file's size is a
+  // corrupt header, and assimp would loop over it (an item without properties takes none).
+  std::uint64_t items = 0;
+  for (const PlyElement& e : elements) {
+    if (e.count > 0 && e.properties.empty())
+      throw InputError(fmt::format("{}: PLY element '{}' has {} items but no properties", f, e.name, e.count));
+    items += e.count;  // each count < file size after the check below, so no overflow
+    if (e.count > data.size() || items > data.size())
+      throw InputError(fmt::format("{}: PLY header declares {} '{}' items; the file has only {} bytes", f, e.count,
+                                   e.name, data.size()));
   }
   if (!binary) return;
   const auto truncated = [&](const PlyElement& e, std::uint64_t item) {

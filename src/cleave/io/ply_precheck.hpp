@@ -7,8 +7,8 @@
 namespace cleave {
 
 /// Throws InputError naming `file` unless it starts with "ply", has an "end_header" line, and
-/// every element and property line of its header is well formed (known scalar types, counts
-/// from 0). For a binary PLY (little- or big-endian) it also walks the declared elements, list
+/// every line of its header is a well-formed format, comment, obj_info, element or property
+/// line (known scalar types, counts from 0 that fit in the file, elements with properties). For a binary PLY (little- or big-endian) it also walks the declared elements, list
 /// counts included, and refuses data shorter than declared, e.g. "body.ply: the binary data ends
 /// at byte 312 while reading element 'vertex' 2 of 8 (truncated?)". The ASCII body is left to
 /// assimp.
