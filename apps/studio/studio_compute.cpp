@@ -33,8 +33,8 @@ constexpr double kRounding = 1e-3;       ///< mm, kPa: result fields
 constexpr double kFrameRounding = 1e-2;  ///< mm: positions in frames and streamlines (0.01 mm)
 
 // The wound opening after a cut: Newmark steps streamed to the page, one frame per step.
-constexpr int kOpeningFrames = 12;
-constexpr double kOpeningStep_s = 0.02;            ///< 12 steps: the first 0.24 s of the opening (Newmark is stable at any step)
+constexpr int kOpeningFrames = 8;
+constexpr double kOpeningStep_s = 0.03;            ///< 8 steps: the first 0.24 s of the opening (Newmark is stable at any step)
 constexpr double kOpeningDamping_per_s = 20.0;     ///< mass damping, as examples/plate_flap_dynamic.json
 
 constexpr int kStreamlineSeedStride = 4;  ///< cells between seeds

@@ -8,13 +8,15 @@ import { freshSessionDir, launchBrowser, mouseDrag, openStudio, requireTools, sc
   waitForResult } from './harness.mjs';
 
 const tools = requireTools();
+// A coarse abdomen (about 2,500 cells of 6.7 mm) keeps the suite short on a loaded 2-core machine.
+const RES = '48x16x32';
 let browser;
 before(async () => { browser = await launchBrowser(tools.chromium); });
 after(async () => { await browser.close(); });
 
 async function withStudio(name, fn, options = {}) {
   const session = options.session ?? freshSessionDir(name);
-  const server = await startServer({ bin: tools.bin, session, ...options });
+  const server = await startServer({ bin: tools.bin, session, res: RES, ...options });
   const page = await openStudio(browser.context, server.url);
   try {
     await fn({ page, server, session });
@@ -33,8 +35,8 @@ test('loads the built-in abdomen and shows its surface with a scale bar', async 
     const r = await page.evaluate(() => window.studio.app.result);
     const s = await page.evaluate(() => window.studio.app.state);
     assert.equal(s.model.source, 'abdomen');
-    assert.deepEqual(s.model.resolution, [63, 21, 42]);
-    assert.ok(r.cells > 3000 && r.cells < 63 * 21 * 42, `abdomen cells ${r.cells}`);
+    assert.deepEqual(s.model.resolution, [48, 16, 32]);
+    assert.ok(r.cells > 1500 && r.cells < 48 * 16 * 32, `abdomen cells ${r.cells}`);
     assert.ok(r.surface.triangles.length >= 3 * 1000, 'a surface with triangles');
     assert.ok(r.surface.positions_mm.every(Number.isFinite), 'finite positions');
     assert.match(await page.locator('#scale-bar .label').textContent(), /^\d+ mm$/);
@@ -154,7 +156,7 @@ test('a scalpel cut drawn by mouse opens and its wound width is reported in mm',
     }, pts.map(([x, y]) => [x, y - 40]));
     await page.evaluate((p) => window.studio.send('add_control_point', { position_mm: window.studio.pickAt(p[0], p[1]).point.toArray(), langer_kPa: 20, cross_kPa: 10 }), pts[10]);
     await page.click('button[data-tool=cut]');
-    await page.fill('#cut-depth', '4');
+    await page.fill('#cut-depth', '10');  // 1.5 cells of the coarse test model
     // Across the stroke direction: a vertical cut through the middle.
     const [x0, y0] = pts[10];
     const vertical = Array.from({ length: 13 }, (_, i) => [x0, y0 - 60 + 10 * i]);
@@ -237,7 +239,7 @@ test('killing the server (SIGKILL) mid-session loses no acknowledged edit', asyn
   const session = freshSessionDir('kill');
   let acknowledged;
   {
-    const server = await startServer({ bin: tools.bin, session });
+    const server = await startServer({ bin: tools.bin, session, res: RES });
     const page = await openStudio(browser.context, server.url);
     await page.click('button[data-tool=stroke]');
     await mouseDrag(page, await surfacePath(page));
