@@ -29,7 +29,8 @@ Mat3 inverse_or_identity(const Mat3& block) {
 
 }  // namespace
 
-std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
+template <typename Scalar>
+std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<Scalar>& a) {
   const auto vertices = static_cast<std::size_t>(a.block_rows());
   std::vector<Mat3> out(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
@@ -39,12 +40,16 @@ std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a) {
       const auto found = std::lower_bound(first, last, static_cast<std::int32_t>(v));
       Mat3 block = Mat3::Zero();
       if (found != last && *found == static_cast<std::int32_t>(v))
-        block = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * (found - a.column.begin()));
+        block = Eigen::Map<const Eigen::Matrix<Scalar, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * (found - a.column.begin()))
+                    .template cast<double>();
       out[v] = inverse_or_identity(block);
     }
   });
   return out;
 }
+
+template std::vector<Mat3> inverse_diagonal_blocks<float>(const BlockSparseMatrix<float>&);
+template std::vector<Mat3> inverse_diagonal_blocks<double>(const BlockSparseMatrix<double>&);
 
 BlockJacobi block_jacobi(const SparseMatrix& a) {
   if (a.rows() % 3 != 0 || a.rows() != a.cols())

@@ -25,7 +25,8 @@ class BlockJacobi final : public Preconditioner {
 
 BlockJacobi block_jacobi(const SparseMatrix& a);
 
-/// The same inverse blocks, from a block CSR matrix.
-std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<double>& a);
+/// The same inverse blocks (in double), from a block CSR matrix (float or double).
+template <typename Scalar>
+std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<Scalar>& a);
 
 }  // namespace cleave

@@ -5,7 +5,6 @@
 
 #include <cmath>
 
-#include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
 namespace {
@@ -33,36 +32,6 @@ void update_direction(Scalar c_d, Scalar c_z, const Eigen::Matrix<Scalar, Eigen:
 
 }  // namespace
 
-ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const ChebyshevOptions& options) {
-  ChebyshevSmoother s;
-  s.options = options;
-  const BlockJacobi diagonal = block_jacobi(a);
-  // Power iteration on D^-1 A from a fixed, non-special start vector (deterministic).
-  const Eigen::Index n = a.rows();
-  Vector x(n), y(n), z(n);
-  for (Eigen::Index i = 0; i < n; ++i) x[i] = 1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i));
-  double estimate = 1;
-  for (int k = 0; k < options.power_iterations; ++k) {
-    const double norm = x.norm();
-    if (!(norm > 0) || !std::isfinite(norm)) break;
-    x /= norm;
-    multiply(a, x, y);
-    diagonal.apply(y, z);
-    estimate = x.dot(z);  // Rayleigh-like quotient (x normalised)
-    x = z;
-  }
-  const double growth = x.norm();
-  if (std::isfinite(growth) && growth > estimate) estimate = growth;
-  s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
-  s.set_inverse_diagonal(diagonal.inverse_blocks);
-  return s;
-}
-
-void ChebyshevSmoother::set_inverse_diagonal(std::vector<Mat3> inverse) {
-  inverse_diagonal = std::move(inverse);
-  inverse_diagonal_single = single_precision(inverse_diagonal);
-}
-
 template <>
 const std::vector<Mat3f>& ChebyshevSmoother::inverse_blocks<float>() const {
   return inverse_diagonal_single;
@@ -71,6 +40,44 @@ template <>
 const std::vector<Mat3>& ChebyshevSmoother::inverse_blocks<double>() const {
   return inverse_diagonal;
 }
+
+template <typename Scalar>
+ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options) {
+  using VectorS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  ChebyshevSmoother s;
+  s.options = options;
+  s.set_inverse_diagonal(inverse_diagonal_blocks(a));
+  const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse = s.inverse_blocks<Scalar>();
+  // Power iteration on D^-1 A from a fixed, non-special start vector (deterministic).
+  const Eigen::Index n = a.rows();
+  VectorS x(n), z(n);
+  const VectorS zero = VectorS::Zero(n);
+  for (Eigen::Index i = 0; i < n; ++i) x[i] = static_cast<Scalar>(1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i)));
+  double estimate = 1;
+  for (int k = 0; k < options.power_iterations; ++k) {
+    const double norm = static_cast<double>(x.norm());
+    if (!(norm > 0) || !std::isfinite(norm)) break;
+    x /= static_cast<Scalar>(norm);
+    jacobi_residual(a, inverse, zero, x, z);  // z = -D^-1 A x
+    z = -z;
+    estimate = static_cast<double>(x.dot(z));  // Rayleigh-like quotient (x normalised)
+    x = z;
+  }
+  const double growth = static_cast<double>(x.norm());
+  if (std::isfinite(growth) && growth > estimate) estimate = growth;
+  s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+  return s;
+}
+
+template ChebyshevSmoother make_chebyshev_smoother<float>(const BlockSparseMatrix<float>&, const ChebyshevOptions&);
+template ChebyshevSmoother make_chebyshev_smoother<double>(const BlockSparseMatrix<double>&, const ChebyshevOptions&);
+
+void ChebyshevSmoother::set_inverse_diagonal(std::vector<Mat3> inverse) {
+  inverse_diagonal = std::move(inverse);
+  inverse_diagonal_single = single_precision(inverse_diagonal);
+}
+
+
 
 template <typename Scalar>
 void ChebyshevSmoother::smooth_from_zero(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,

@@ -5,9 +5,9 @@
 // same smoother before and after the coarse correction keeps the V-cycle symmetric (a valid CG
 // preconditioner); every step is one parallel pass over the matrix (residual and D^-1 fused).
 //
-//   ChebyshevSmoother s = make_chebyshev_smoother(a, options);   // a: double CSR (estimate)
-//   s.smooth_from_zero(blocks, b, x, work);   // x = p(D^-1 A) D^-1 b       (blocks: a in float)
-//   s.smooth(blocks, b, x, work);             // x += p(D^-1 A) D^-1 (b - A x)
+//   ChebyshevSmoother s = make_chebyshev_smoother(a, options);   // a: block CSR, float or double
+//   s.smooth_from_zero(a, b, x, work);   // x = p(D^-1 A) D^-1 b
+//   s.smooth(a, b, x, work);             // x += p(D^-1 A) D^-1 (b - A x)
 //
 // Smoothing runs on the block CSR copy of a (block_sparse_matrix.hpp), in single precision where
 // the multigrid cycle does (half the bytes streamed; the outer double-precision CG absorbs the
@@ -39,6 +39,9 @@ class ChebyshevSmoother {
 
   /// New D^-1 (new values of the same matrix); lambda_max is kept.
   void set_inverse_diagonal(std::vector<Mat3> inverse);
+  /// D^-1 in the given precision.
+  template <typename Scalar>
+  const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_blocks() const;
 
   template <typename Scalar>
   void smooth_from_zero(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
@@ -52,10 +55,10 @@ class ChebyshevSmoother {
   template <typename Scalar>
   void iterate(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
                Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work, Start start) const;
-  template <typename Scalar>
-  const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_blocks() const;
 };
 
-ChebyshevSmoother make_chebyshev_smoother(const SparseMatrix& a, const ChebyshevOptions& options = {});
+/// D^-1 and the lambda_max estimate from `a` (power iteration in a's precision).
+template <typename Scalar>
+ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options = {});
 
 }  // namespace cleave

@@ -5,6 +5,8 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include <utility>
 
 namespace cleave {
@@ -101,28 +103,29 @@ std::vector<std::uint8_t> identity_rows(const SparseMatrix& a) {
 SparseMatrix galerkin_operator(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed, const Prolongation& p) {
   const auto fine_vertices = static_cast<std::size_t>(p.fine_count());
   const auto coarse_vertices = static_cast<std::size_t>(p.coarse_count());
-  const auto* outer = a.outerIndexPtr();
-  const auto* inner = a.innerIndexPtr();
-  const double* values = a.valuePtr();
-
-  // A P by fine block rows: (A P)[i, J] = sum_j A[i, j] P[j, J] over free columns j.
+  // A P by fine block rows: (A P)[i, J] = sum_j A[i, j] P[j, J] over free rows and columns,
+  // one 3x3 block of A at a time (A as block CSR).
+  const BlockSparseMatrix<double> blocks = to_block_sparse<double>(a);
   BlockRows ap(fine_vertices);
   tbb::enumerable_thread_specific<BlockRowAccumulator> ap_accumulators([&] { return BlockRowAccumulator(coarse_vertices); });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, fine_vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {
     BlockRowAccumulator& acc = ap_accumulators.local();
     for (std::size_t i = range.begin(); i < range.end(); ++i) {
-      for (int axis = 0; axis < 3; ++axis) {
-        const std::size_t row = 3 * i + static_cast<std::size_t>(axis);
-        if (fixed[row]) continue;
-        for (auto k = outer[row]; k < outer[row + 1]; ++k) {
-          const auto column = static_cast<std::size_t>(inner[k]);
-          if (fixed[column] || values[k] == 0) continue;
-          const std::size_t j = column / 3;
-          const auto b = static_cast<Eigen::Index>(column % 3);
-          for (int e = p.fine_start[j]; e < p.fine_start[j + 1]; ++e) {
-            const auto& entry = p.by_fine[static_cast<std::size_t>(e)];
-            acc.at(entry.vertex)(axis, b) += values[k] * entry.weight;
-          }
+      const Vec3 row_free(fixed[3 * i] ? 0.0 : 1.0, fixed[3 * i + 1] ? 0.0 : 1.0, fixed[3 * i + 2] ? 0.0 : 1.0);
+      if (row_free.isZero()) {
+        ap[i].clear();
+        continue;
+      }
+      for (auto k = blocks.row_start[i]; k < blocks.row_start[i + 1]; ++k) {
+        const auto j = static_cast<std::size_t>(blocks.column[static_cast<std::size_t>(k)]);
+        const Vec3 column_free(fixed[3 * j] ? 0.0 : 1.0, fixed[3 * j + 1] ? 0.0 : 1.0, fixed[3 * j + 2] ? 0.0 : 1.0);
+        const Mat3 block = row_free.asDiagonal() *
+                           Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(blocks.values.data() + 9 * static_cast<std::size_t>(k)) *
+                           column_free.asDiagonal();
+        if (block.isZero(0.0)) continue;
+        for (int e = p.fine_start[j]; e < p.fine_start[j + 1]; ++e) {
+          const auto& entry = p.by_fine[static_cast<std::size_t>(e)];
+          acc.at(entry.vertex) += entry.weight * block;
         }
       }
       ap[i] = acc.take_sorted();

@@ -118,9 +118,14 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
   }
   m.precision_ = options.precision;
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
-    m.levels_[l].smoother = make_chebyshev_smoother(m.operator_of(l), options.smoother);
-    if (m.precision_ == CyclePrecision::single_precision) m.levels_[l].single.blocks = to_block_sparse<float>(m.operator_of(l));
-    else m.levels_[l].twin.blocks = to_block_sparse<double>(m.operator_of(l));
+    MultigridLevel& level = m.levels_[l];
+    if (m.precision_ == CyclePrecision::single_precision) {
+      level.single.blocks = to_block_sparse<float>(m.operator_of(l));
+      level.smoother = make_chebyshev_smoother(level.single.blocks, options.smoother);
+    } else {
+      level.twin.blocks = to_block_sparse<double>(m.operator_of(l));
+      level.smoother = make_chebyshev_smoother(level.twin.blocks, options.smoother);
+    }
   }
 
   m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
