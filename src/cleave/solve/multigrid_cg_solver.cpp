@@ -12,9 +12,10 @@
 namespace cleave {
 namespace {
 
-/// CG with the single-precision cycle needs 10 to 30 iterations where it works; one that has not
-/// converged after this many goes on with the double-precision cycle.
-constexpr int kSinglePrecisionMaxIterations = 100;
+/// CG with the single-precision cycle needs 10 to 30 iterations where it works (tests: 14 to 28);
+/// one that has not converged after this many goes on with the double-precision cycle (the bench's
+/// incised abdomen, with free plugs on 3-2-1 supports, then needs about 17 more).
+constexpr int kSinglePrecisionMaxIterations = 40;
 
 class MultigridCgSolver final : public LinearSolver {
  public:
