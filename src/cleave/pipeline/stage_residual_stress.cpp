@@ -79,7 +79,9 @@ void run_design(RunContext& ctx, StressDesign design) {
       {"held_vertices", design.held_vertices.size()},
       {"equilibrium_residual_designed", result.residual_designed},
       {"equilibrium_residual_final", result.residual_final},
-      {"equilibrium_residual_definition", "||T sigma|| / (||T||_2 ||sigma||) over all vertices, ||T||_2 by power iteration"},
+      {"equilibrium_residual_definition",
+       "||T sigma|| / (||T||_2 ||sigma||) over the free vertices (all unless equilibrium_support is simulation), ||T||_2 by "
+       "power iteration"},
       {"eigenvalue_iterations", result.eigenvalue_iterations},
       {"timings_s",
        {{"directions", result.timings.directions_s},
