@@ -59,6 +59,10 @@ void Dynamics::rebuild_topology() {
 void Dynamics::update_rotations() { cell_rotations(model_.volume, u_, rotations_); }
 
 void Dynamics::topology_changed(const CutReport& report) {
+  // Cut links without divided vertices leave K, M and the pattern as they are (cells still share
+  // those vertices); the solver keeps its structure (the multigrid's levels, built with the old
+  // links, stay a valid preconditioner and are rebuilt when iterations grow).
+  if (report.splits.empty()) return;
   const LinkedVolume& volume = model_.volume;
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   const Eigen::Index old = u_.size();
