@@ -64,12 +64,47 @@ EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const
         entries.emplace_back(static_cast<int>(3 * it.row() + i), static_cast<int>(3 * it.col() + i), weights.laplacian * it.value());
   smoothness_.resize(3 * ltl.rows(), 3 * ltl.cols());
   smoothness_.setFromTriplets(entries.begin(), entries.end());
+  scalar_smoothness_ = weights.laplacian * ltl;
+  scalar_smoothness_.makeCompressed();
 }
 
 EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFrame>& frames,
                                                  const std::vector<EigenvalueTarget>& targets, EigenvalueSolver solver,
                                                  const std::vector<Vec3>& warm_start) {
   const Eigen::Index n = 3 * static_cast<Eigen::Index>(volume_.cell_count());
+  for (const EigenvalueTarget& t : targets)
+    if (t.cell < 0 || t.cell >= volume_.cell_count())
+      throw InputError(fmt::format("eigenvalue target names cell {}; expected 0 to {}", t.cell, volume_.cell_count() - 1));
+  std::vector<CellId> constrained;
+  for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
+  const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
+
+  if (weights_.equilibrium == 0.0 && solver == EigenvalueSolver::cholesky) {
+    // Three independent fields: (w_L L^T L + constraints) Lambda = B, Lambda n_c x 3.
+    const CellId cells = volume_.cell_count();
+    Eigen::SparseMatrix<double> system = scalar_smoothness_;
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(cells, 3);
+    for (const EigenvalueTarget& t : targets) {
+      system.coeffRef(t.cell, t.cell) += weights_.constraint;
+      rhs.row(t.cell) += weights_.constraint * t.eigenvalues_kPa.transpose();
+    }
+    for (CellId c = 0; c < cells; ++c)
+      if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // no control point -> 0
+    system.makeCompressed();
+    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(cells, 3);
+    if (static_cast<Eigen::Index>(warm_start.size()) == cells)
+      for (CellId c = 0; c < cells; ++c) x.row(c) = warm_start[static_cast<std::size_t>(c)].transpose();
+    if (!cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
+      cholesky_.factorize(system);
+      ++factorizations_;
+      x = cholesky_.solve_refined(system, rhs);
+    }
+    EigenvalueSolution solution;
+    solution.eigenvalues_kPa.resize(static_cast<std::size_t>(cells));
+    for (CellId c = 0; c < cells; ++c) solution.eigenvalues_kPa[static_cast<std::size_t>(c)] = x.row(c).transpose();
+    return solution;
+  }
+
   Eigen::SparseMatrix<double> system = smoothness_;
   if (weights_.equilibrium > 0.0) {
     const double h = volume_.grid().cell_size_mm;
@@ -81,16 +116,11 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
   }
   Vector rhs = Vector::Zero(n);
   for (const EigenvalueTarget& t : targets) {
-    if (t.cell < 0 || t.cell >= volume_.cell_count())
-      throw InputError(fmt::format("eigenvalue target names cell {}; expected 0 to {}", t.cell, volume_.cell_count() - 1));
     for (int i = 0; i < 3; ++i) {
       system.coeffRef(3 * t.cell + i, 3 * t.cell + i) += weights_.constraint;
       rhs[3 * t.cell + i] += weights_.constraint * t.eigenvalues_kPa[i];
     }
   }
-  std::vector<CellId> constrained;
-  for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
-  const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
   for (CellId c = 0; c < volume_.cell_count(); ++c)
     if (pinned[static_cast<std::size_t>(c)])
       for (int i = 0; i < 3; ++i) system.coeffRef(3 * c + i, 3 * c + i) += weights_.laplacian;  // no control point -> 0
