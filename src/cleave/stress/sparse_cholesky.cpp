@@ -4,6 +4,7 @@
 #include "cleave/stress/sparse_cholesky.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <cmath>
 #include <vector>
 
 #include "cleave/core/error.hpp"
@@ -83,6 +84,9 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       r -= alpha * ap;
       converged = r.norm() <= relative_tolerance * b_norm;
       if (converged) break;
+      // Off track for a geometric rate (a stroke edit changes hundreds of rows: CG stalls near
+      // 1e-5): give up early so the caller's factorization is not preceded by wasted solves.
+      if (it + 1 == max_iterations / 4 && r.norm() > std::sqrt(relative_tolerance) * b_norm) return false;
       z = impl_->llt.solve(r);
       const double rz_next = r.dot(z);
       p = z + (rz_next / rz) * p;

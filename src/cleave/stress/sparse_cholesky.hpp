@@ -33,7 +33,8 @@ class SparseCholesky {
   /// is a low-rank change, so CG needs about as many iterations as the rank of the change and no
   /// new factorization is needed. Returns true when every column reached
   /// ||b - a x|| <= relative_tolerance ||b|| within max_iterations; false (x unspecified) when
-  /// there is no factor, the pattern differs, or CG did not get there: then factorize(a).
+  /// there is no factor, the pattern differs, or CG did not get there (it stops after a quarter of
+  /// max_iterations when the residual is still above sqrt(relative_tolerance)): then factorize(a).
   bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
                                  double relative_tolerance, int max_iterations) const;
   /// Numeric factorizations that could reuse the previous symbolic analysis.
