@@ -4,6 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <iterator>
 
 namespace cleave {
 namespace {
@@ -49,10 +50,22 @@ BlockSparseMatrix<Scalar> to_block_sparse(const SparseMatrix& a) {
   std::vector<std::vector<std::int32_t>> columns(static_cast<std::size_t>(n));
   for_each_block_row(n, [&](Eigen::Index v) {
     auto& c = columns[static_cast<std::size_t>(v)];
-    for (int i = 0; i < 3; ++i)
-      for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) c.push_back(inner[k] / 3);
-    std::sort(c.begin(), c.end());
-    c.erase(std::unique(c.begin(), c.end()), c.end());
+    // Sorted rows: the block columns of one row come out sorted; the three rows of a vertex
+    // usually have the same ones (the vertex-block pattern), and only otherwise are merged.
+    const auto row_blocks = [&](int i, std::vector<std::int32_t>& out) {
+      out.clear();
+      for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k)
+        if (out.empty() || out.back() != inner[k] / 3) out.push_back(inner[k] / 3);
+    };
+    row_blocks(0, c);
+    std::vector<std::int32_t> other;
+    for (int i = 1; i < 3; ++i) {
+      row_blocks(i, other);
+      if (other == c) continue;
+      std::vector<std::int32_t> merged;
+      std::set_union(c.begin(), c.end(), other.begin(), other.end(), std::back_inserter(merged));
+      c.swap(merged);
+    }
   });
   b.row_start.assign(static_cast<std::size_t>(n) + 1, 0);
   for (Eigen::Index v = 0; v < n; ++v)
