@@ -37,7 +37,7 @@ struct DesignWeights {
 
 /// How the eigenvalue normal equations A^T A lambda = A^T b are solved.
 enum class EigenvalueSolver {
-  cholesky,  ///< default: sparse Cholesky (CHOLMOD supernodal) of A^T A, symbolic analysis reused
+  cholesky,  ///< default: sparse Cholesky (CHOLMOD supernodal) of A^T A, kept to precondition CG after edits
   paper_cg,  ///< reference: the paper's plain conjugate gradients on A^T A, one thread
 };
 

@@ -4,9 +4,11 @@
 // normal field, symbolic factorizations) so that each edit only redoes what depends on it:
 //   stroke edits          -> Langer line field, frames, eigenvalues, stress
 //   control point edits   -> eigenvalues, stress (frames are kept)
-// Warm start: the Cholesky solvers reuse their symbolic analysis (the pattern only depends on the
-// topology); the paper CG starts from the previous eigenvalues. An edit gives the same result as
-// a fresh designer with the final design (within solver tolerance).
+// Warm start: every factorization (Langer field, eigenvalues, the equilibration's Kc) is kept;
+// after an edit it preconditions CG on the edited system from the previous solution, and a
+// system is refactorized only when that CG is off track (stroke edits of the Langer field). The
+// paper CG starts from the previous eigenvalues. An edit gives the same result as a fresh
+// designer with the final design (within solver tolerance).
 //
 //   StressDesigner designer(model, design);         // computes everything; InputError on bad design
 //   designer.add_stroke({{p0, p1, p2}});            // recomputes
