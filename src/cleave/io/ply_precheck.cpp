@@ -47,7 +47,16 @@ std::uint64_t list_count(const unsigned char* p, std::size_t bytes, bool big_end
 void require_well_formed_ply(const std::filesystem::path& file) {
   const std::string data = read_file(file);
   const std::string f = file.string();
-  const std::size_t header_end = data.find("end_header");
+  // The header ends at a line that is exactly "end_header" ("end_headerint" made assimp hang in
+  // read(); found by fuzz_mesh_ply).
+  std::size_t header_end = std::string::npos;
+  for (std::size_t at = data.find("\nend_header"); at != std::string::npos; at = data.find("\nend_header", at + 1)) {
+    const std::size_t after = at + 11;
+    if (after < data.size() && (data[after] == '\n' || (data[after] == '\r' && after + 1 < data.size() && data[after + 1] == '\n'))) {
+      header_end = at + 1;
+      break;
+    }
+  }
   if (data.rfind("ply", 0) != 0 || header_end == std::string::npos)
     throw InputError(fmt::format("{}: not a PLY file (expected 'ply' first and an 'end_header' line)", f));
   const auto malformed = [&](const std::string& line) {
