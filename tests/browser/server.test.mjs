@@ -108,6 +108,10 @@ test('malformed, oversized and unknown messages get an error reply and the sessi
     [{ cmd: 'load', file: '/etc/passwd' }, /outside the session folder/],
     [{ cmd: 'export', format: 'vtu', file: '../../x.vtu' }, /outside the session folder/],
     [{ cmd: 'undo' }, /nothing to undo/],
+    // 40 three-byte characters: the name is quoted up to 80 bytes without cutting a character
+    // (a cut one made the reply invalid UTF-8 and its dump threw out of the read handler).
+    [{ cmd: '\u20ac'.repeat(40) }, /unknown command '\u20ac{26}'/],
+    [{ cmd: 'save', file: '\u20ac'.repeat(100) + '.json' }, /outside the session folder|\u20ac/],
   ];
   for (const [message, expected] of cases) {
     const r = await request(ws, message);
