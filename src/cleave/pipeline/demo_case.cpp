@@ -72,7 +72,8 @@ json abdomen_demo_case(const TissueModel& model, DemoStress stress) {
                                             box(-1, -1, -1, w + 1, top, kRimMm), box(-1, -1, l - kRimMm, w + 1, top, l + 1),
                                             {{"surface", "inner"}}})}};
   if (with_design)
-    c["design"] = {{"strokes", strokes}, {"control_points", controls}, {"weights", {{"equilibrium", 0.0}}}, {"equilibrate", false}};
+    c["design"] = {{"strokes", strokes}, {"control_points", controls}, {"weights", {{"equilibrium", 0.0}}}, {"equilibrate", true},
+                   {"equilibrium_support", "simulation"}};
   else
     c["residual_stress"] = {{"uniform_kPa", json::array({kLangerKPa, 0.0, kCrossKPa, 0.0, 0.0, 0.0})}};
   return c;
