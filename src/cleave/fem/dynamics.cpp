@@ -211,11 +211,14 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    if (solver_ready_) {
-      solver_->update_values(system_, model_.volume);  // same pattern: the solver keeps its structure
+    // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
+    // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
+    if (solver_ready_ && c_mass == solver_mass_factor_) {
+      solver_->update_values(system_, model_.volume);
     } else {
       solver_->setup(system_, model_.volume);
       solver_ready_ = true;
+      solver_mass_factor_ = c_mass;
     }
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));

@@ -97,6 +97,7 @@ class Dynamics {
   std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
   bool any_fixed_ = false;
   bool solver_ready_ = false;  ///< set up on the current pattern (later steps only update values)
+  double solver_mass_factor_ = 0;  ///< c_m of the matrix the solver was set up with (1/s^2)
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;
   double time_s_ = 0;
