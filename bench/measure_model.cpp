@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "cleave/core/error.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
 #include "measure_design.hpp"
@@ -107,7 +108,13 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
       figures.peers.push_back(skipped(peer, fmt::format("{} cells is above --peer-max-cells {}", figures.cells, options.peer_max_cells)));
       continue;
     }
-    ImplementationResults r = run_implementation(model, scenario, peer, options, progress, share * static_cast<double>(i + 1), share);
+    ImplementationResults r;
+    try {
+      r = run_implementation(model, scenario, peer, options, progress, share * static_cast<double>(i + 1), share);
+    } catch (const ComputeError& e) {  // a peer that fails (e.g. Eigen CG out of iterations) is reported, not fatal
+      figures.peers.push_back(skipped(peer, fmt::format("failed: {}", e.what())));
+      continue;
+    }
     compare_with_cleave(cleave, r);
     r.figures.update = composite_update(cleave.figures, r.figures);
     figures.peers.push_back(std::move(r.figures));
