@@ -36,4 +36,6 @@ find_path(OPENVDB_INCLUDE_DIR openvdb/openvdb.h REQUIRED)
 find_library(OPENVDB_LIBRARY openvdb REQUIRED)
 add_library(cleave_openvdb INTERFACE)
 target_include_directories(cleave_openvdb SYSTEM INTERFACE ${OPENVDB_INCLUDE_DIR})
-target_link_libraries(cleave_openvdb INTERFACE ${OPENVDB_LIBRARY} TBB::tbb)
+# OpenVDB's headers use Imath's half tables; link Imath explicitly (clang at -O1 does not inline them).
+find_package(Imath CONFIG REQUIRED)
+target_link_libraries(cleave_openvdb INTERFACE ${OPENVDB_LIBRARY} Imath::Imath TBB::tbb)
