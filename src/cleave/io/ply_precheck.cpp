@@ -1,10 +1,12 @@
 #include "cleave/io/ply_precheck.hpp"
 
 #include <algorithm>
+#include <cctype>
 #include <cstdint>
 #include <fmt/format.h>
 #include <sstream>
 #include <string>
+#include <string_view>
 #include <vector>
 
 #include "cleave/core/error.hpp"
@@ -24,6 +26,17 @@ std::size_t type_bytes(const std::string& type) {
   return 0;
 }
 
+bool is_integer_type(const std::string& type) {
+  return type_bytes(type) > 0 && type != "float" && type != "float32" && type != "double" && type != "float64";
+}
+
+/// Element names are words ("vertex", "face"); assimp reads leading digits of a name as a count.
+bool is_identifier(const std::string& name) {
+  if (name.empty() || !(std::isalpha(static_cast<unsigned char>(name[0])) || name[0] == '_')) return false;
+  return std::all_of(name.begin(), name.end(),
+                     [](char c) { return std::isalnum(static_cast<unsigned char>(c)) || c == '_' || c == '-'; });
+}
+
 struct PlyProperty {
   std::size_t bytes = 0;        ///< scalar size, or the size of one list item
   std::size_t count_bytes = 0;  ///< size of the list count (0: not a list)
@@ -40,6 +53,49 @@ std::uint64_t list_count(const unsigned char* p, std::size_t bytes, bool big_end
   std::uint64_t v = 0;
   for (std::size_t k = 0; k < bytes; ++k) v |= std::uint64_t{p[big_endian ? bytes - 1 - k : k]} << (8 * k);
   return v;
+}
+
+/// Walks the ASCII body as assimp reads it, one item per line: every scalar must be there and
+/// every list count must be a whole number no larger than the tokens left on its line (assimp
+/// allocated a list of 3444...4 items; found by fuzz_mesh_ply).
+void require_ascii_items_fit(const std::string& data, std::size_t pos, const std::vector<PlyElement>& elements,
+                             const std::string& f) {
+  for (const PlyElement& e : elements) {
+    for (std::uint64_t item = 0; item < e.count; ++item) {
+      // the item's line (blank lines skipped)
+      std::string_view line;
+      while (line.find_first_not_of(" \t\r") == std::string_view::npos) {
+        if (pos >= data.size())
+          throw InputError(fmt::format("{}: the ASCII data ends while reading element '{}' {} of {} (truncated?)", f,
+                                       e.name, item, e.count));
+        const std::size_t eol = std::min(data.find('\n', pos), data.size());
+        line = std::string_view(data).substr(pos, eol - pos);
+        pos = eol + 1;
+      }
+      std::size_t at = 0;
+      const auto next_token = [&]() -> std::string_view {
+        while (at < line.size() && (line[at] == ' ' || line[at] == '\t' || line[at] == '\r')) ++at;
+        const std::size_t begin = at;
+        while (at < line.size() && line[at] != ' ' && line[at] != '\t' && line[at] != '\r') ++at;
+        return line.substr(begin, at - begin);
+      };
+      for (const PlyProperty& p : e.properties) {
+        const std::string_view token = next_token();
+        if (token.empty())
+          throw InputError(fmt::format("{}: element '{}' {} has fewer values than its {} properties", f, e.name, item,
+                                       e.properties.size()));
+        if (p.count_bytes == 0) continue;
+        const bool whole = std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; });
+        const std::uint64_t n = whole && token.size() <= 9 ? std::stoull(std::string(token)) : 0;
+        if (!whole || token.size() > 9 || n > (line.size() - at + 1) / 2)
+          throw InputError(fmt::format("{}: element '{}' {} has a list of '{}' items; expected a count its line can hold",
+                                       f, e.name, item, utf8_prefix(utf8_sanitized(std::string(token)), 40)));
+        for (std::uint64_t k = 0; k < n; ++k)
+          if (next_token().empty())
+            throw InputError(fmt::format("{}: element '{}' {} has a list of {} items but fewer values", f, e.name, item, n));
+      }
+    }
+  }
 }
 
 }  // namespace
@@ -74,15 +130,18 @@ void require_well_formed_ply(const std::filesystem::path& file) {
     if (keyword.empty() || keyword == "ply" || keyword == "comment" || keyword == "obj_info") {
       continue;
     } else if (keyword == "format") {
-      std::string format;
-      words >> format;
+      std::string format, version;
+      words >> format >> version;
+      // assimp reads an unknown format as ASCII and misparses the rest (a 64 GB allocation found by fuzz_mesh_ply)
+      if ((format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") || version != "1.0")
+        malformed(line);
       binary = format == "binary_little_endian" || format == "binary_big_endian";
       big_endian = format == "binary_big_endian";
     } else if (keyword == "element") {
       PlyElement e;
       long long count = -1;
       words >> e.name >> count;
-      if (words.fail() || count < 0) malformed(line);
+      if (words.fail() || count < 0 || !is_identifier(e.name)) malformed(line);
       e.count = static_cast<std::uint64_t>(count);
       elements.push_back(e);
     } else if (keyword == "property") {
@@ -95,7 +154,7 @@ void require_well_formed_ply(const std::filesystem::path& file) {
         words >> count_type >> item_type;
         p.count_bytes = type_bytes(count_type);
         p.bytes = type_bytes(item_type);
-        if (p.count_bytes == 0 || p.bytes == 0) malformed(line);
+        if (p.count_bytes == 0 || p.bytes == 0 || !is_integer_type(count_type)) malformed(line);
       } else {
         p.bytes = type_bytes(type);
         if (p.bytes == 0) malformed(line);
@@ -116,7 +175,10 @@ void require_well_formed_ply(const std::filesystem::path& file) {
       throw InputError(fmt::format("{}: PLY header declares {} '{}' items; the file has only {} bytes", f, e.count,
                                    e.name, data.size()));
   }
-  if (!binary) return;
+  if (!binary) {
+    require_ascii_items_fit(data, pos, elements, f);
+    return;
+  }
   const auto truncated = [&](const PlyElement& e, std::uint64_t item) {
     throw InputError(fmt::format("{}: the binary data ends at byte {} while reading element '{}' {} of {} (truncated?)",
                                  f, data.size(), e.name, item, e.count));
