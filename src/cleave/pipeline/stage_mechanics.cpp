@@ -1,35 +1,17 @@
 #include <fmt/format.h>
 
 #include "cleave/core/units.hpp"
-#include "cleave/cut/surface_side_vertices.hpp"
 #include "cleave/fem/cell_stress.hpp"
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/lumped_mass.hpp"
 #include "cleave/fem/solve_static.hpp"
 #include "cleave/io/case_mechanics.hpp"
+#include "cleave/pipeline/held_vertices.hpp"
 #include "cleave/pipeline/stages.hpp"
 
 namespace cleave {
 namespace {
-
-std::vector<VertexId> held_vertices(const TissueModel& model, const SimulationSettings& s) {
-  const LinkedVolume& volume = model.volume;
-  std::vector<std::uint8_t> held(static_cast<std::size_t>(volume.vertex_count()), 0);
-  for (const FixedBox& box : s.fixed_boxes)
-    for (const VertexId v : vertices_in_box(volume, box.lo_mm, box.hi_mm)) held[static_cast<std::size_t>(v)] = 1;
-  if (!s.fixed_surfaces.empty()) {
-    const BodySurface surface(model);
-    for (const FixedSurface side : s.fixed_surfaces) {
-      const SurfaceSide which = side == FixedSurface::inner ? SurfaceSide::inner : SurfaceSide::all;
-      for (const VertexId v : surface_side_vertices(surface, which)) held[static_cast<std::size_t>(v)] = 1;
-    }
-  }
-  std::vector<VertexId> out;
-  for (VertexId v = 0; v < volume.vertex_count(); ++v)
-    if (held[static_cast<std::size_t>(v)]) out.push_back(v);
-  return out;
-}
 
 DataArray vector_array(const std::string& name, std::span<const Vec3> values) {
   DataArray a{name, 3, {}};

@@ -9,11 +9,10 @@
 
 #include "cleave/core/error.hpp"
 #include "cleave/core/units.hpp"
-#include "cleave/cut/surface_side_vertices.hpp"
-#include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/io/case_design.hpp"
 #include "cleave/io/case_mechanics.hpp"
 #include "cleave/io/vtp_writer.hpp"
+#include "cleave/pipeline/held_vertices.hpp"
 #include "cleave/pipeline/stages.hpp"
 #include "cleave/stress/stress_designer.hpp"
 #include "cleave/viz/streamlines.hpp"
@@ -37,28 +36,8 @@ DataArray eigenvalue_array(const std::vector<Vec3>& eigenvalues_kPa) {
   return a;
 }
 
-/// The vertices that the case's "simulation" section holds (boxes and surfaces), on the uncut model.
-std::vector<VertexId> simulation_held_vertices(const RunContext& ctx) {
-  const SimulationSettings s = parse_simulation_settings(ctx.case_file);
-  const LinkedVolume& volume = ctx.model.volume;
-  std::vector<std::uint8_t> held(static_cast<std::size_t>(volume.vertex_count()), 0);
-  for (const FixedBox& box : s.fixed_boxes)
-    for (const VertexId v : vertices_in_box(volume, box.lo_mm, box.hi_mm)) held[static_cast<std::size_t>(v)] = 1;
-  if (!s.fixed_surfaces.empty()) {
-    const BodySurface surface(ctx.model);
-    for (const FixedSurface side : s.fixed_surfaces) {
-      const SurfaceSide which = side == FixedSurface::inner ? SurfaceSide::inner : SurfaceSide::all;
-      for (const VertexId v : surface_side_vertices(surface, which)) held[static_cast<std::size_t>(v)] = 1;
-    }
-  }
-  std::vector<VertexId> out;
-  for (VertexId v = 0; v < volume.vertex_count(); ++v)
-    if (held[static_cast<std::size_t>(v)]) out.push_back(v);
-  return out;
-}
-
 void run_design(RunContext& ctx, StressDesign design) {
-  if (design.support == EquilibriumSupport::simulation) design.held_vertices = simulation_held_vertices(ctx);
+  if (design.support == EquilibriumSupport::simulation) design.held_vertices = held_vertices(ctx.model, parse_simulation_settings(ctx.case_file));
   DesignResult result;
   try {
     result = design_residual_stress(ctx.model, design);
