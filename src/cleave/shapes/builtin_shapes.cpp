@@ -25,7 +25,6 @@ constexpr double kAbdomenWidthMm = 315.0;
 constexpr double kAbdomenThicknessMm = 10.8;
 constexpr double kAbdomenDomeHeightMm = 70.0;
 constexpr double kPlateWidthMm = 100.0;
-constexpr double kPlateThicknessMm = 10.0;
 
 float tube_distance(const Vec3& p, const Vec3& extent) {
   const double outer = 0.5 * extent.x();
@@ -81,6 +80,7 @@ const std::vector<ShapeDefinition>& shapes() {
   static const std::vector<ShapeDefinition> all = {
       {"cylinder", {21, 21, 26}, kTubeDiameterMm / 21, tube_distance, [](const Vec3&, const Vec3&) { return Label{1}; }},
       {"abdomen", {63, 21, 42}, kAbdomenWidthMm / 63, abdomen_distance, abdomen_label},
+      // 100 x 100 mm, 4 cells = 10 mm thick
       {"plate", {40, 40, 4}, kPlateWidthMm / 40, plate_distance, [](const Vec3&, const Vec3&) { return Label{1}; }},
   };
   return all;

@@ -18,7 +18,7 @@ Vec3 distance_gradient(const TissueModel& model, CellId c) {
   Vec3 g = Vec3::Zero();
   for (int corner = 0; corner < kCornerCount; ++corner) {
     const Vec3i o = corner_offset(corner);
-    const double d = labels.corner_distance_mm[static_cast<std::size_t>(grid.corner_index(v + o))];
+    const double d = static_cast<double>(labels.corner_distance_mm[static_cast<std::size_t>(grid.corner_index(v + o))]);
     for (int axis = 0; axis < 3; ++axis) g[axis] += (o[axis] == 1 ? d : -d);
   }
   return g / (4.0 * grid.cell_size_mm);
