@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/solve/plain_conjugate_gradient.hpp"
 #include "cleave/stress/cell_laplacian.hpp"
 #include "cleave/stress/stroke_constraints.hpp"
 
@@ -14,33 +15,13 @@ using RowMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 /// The same Tikhonov guard as stress/line_field_interpolation.cpp (relative to w_L).
 constexpr double kGuard = 1e-10;
 
-/// Plain CG on one thread: x holds the start on entry and the solution on exit.
+/// The paper's plain CG (one thread, no preconditioner) from x; returns its iterations.
 int plain_conjugate_gradients(const RowMatrix& a, const Eigen::VectorXd& b, Eigen::VectorXd& x) {
-  const double b_norm = b.norm();
-  if (b_norm == 0) {
-    x.setZero();
-    return 0;
-  }
-  Eigen::VectorXd r = b - a * x;
-  Eigen::VectorXd p = r;
-  Eigen::VectorXd ap(x.size());
-  double rr = r.squaredNorm();
-  const double stop = kPaperCgRelativeTolerance * kPaperCgRelativeTolerance * b_norm * b_norm;
-  int k = 0;
-  while (rr > stop) {
-    if (k == kPaperCgMaxIterations)
-      throw ComputeError(fmt::format("paper CG for the direction fields did not converge: relative residual {:.3g} after {} iterations",
-                                     std::sqrt(rr) / b_norm, k));
-    ap.noalias() = a * p;
-    const double alpha = rr / p.dot(ap);
-    x += alpha * p;
-    r -= alpha * ap;
-    const double rr_next = r.squaredNorm();
-    p = r + (rr_next / rr) * p;
-    rr = rr_next;
-    ++k;
-  }
-  return k;
+  const PlainCgOutcome cg = plain_conjugate_gradient(a, b, x, kPaperCgRelativeTolerance, kPaperCgMaxIterations);
+  if (cg.relative_residual > kPaperCgRelativeTolerance)
+    throw ComputeError(fmt::format("paper CG for the direction fields did not converge: relative residual {:.3g} after {} iterations",
+                                   cg.relative_residual, cg.iterations));
+  return cg.iterations;
 }
 
 /// Solves the 6 component systems of one line field; returns the tensors and adds the iterations.

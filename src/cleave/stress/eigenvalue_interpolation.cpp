@@ -7,6 +7,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/solve/plain_conjugate_gradient.hpp"
 #include "cleave/stress/cell_laplacian.hpp"
 #include "cleave/stress/equilibrium_operator.hpp"
 
@@ -15,38 +16,6 @@ namespace {
 
 constexpr double kPaperCgTolerance = 1e-12;    ///< relative residual of the reference CG
 constexpr int kPaperCgMaxIterations = 200000;  ///< the plain CG needs many iterations on A^T A
-
-struct CgOutcome {
-  int iterations = 0;
-  double relative_residual = 0;
-};
-
-/// The paper's solver: plain conjugate gradients on the SPD system a x = b, one thread, no
-/// preconditioner, from the initial x.
-CgOutcome plain_conjugate_gradient(const Eigen::SparseMatrix<double>& a, const Vector& b, Vector& x) {
-  CgOutcome out;
-  const double b_norm = b.norm();
-  if (b_norm == 0.0) {
-    x.setZero();
-    return out;
-  }
-  Vector r = b - a * x;
-  Vector p = r;
-  double rr = r.squaredNorm();
-  out.relative_residual = std::sqrt(rr) / b_norm;
-  while (out.relative_residual > kPaperCgTolerance && out.iterations < kPaperCgMaxIterations) {
-    const Vector ap = a * p;
-    const double alpha = rr / p.dot(ap);
-    x += alpha * p;
-    r -= alpha * ap;
-    const double rr_next = r.squaredNorm();
-    p = r + (rr_next / rr) * p;
-    rr = rr_next;
-    ++out.iterations;
-    out.relative_residual = std::sqrt(rr) / b_norm;
-  }
-  return out;
-}
 
 }  // namespace
 
@@ -143,7 +112,7 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
     x = Vector::Zero(n);
     if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)
       for (std::size_t c = 0; c < warm_start.size(); ++c) x.segment<3>(3 * static_cast<Eigen::Index>(c)) = warm_start[c];
-    const CgOutcome cg = plain_conjugate_gradient(system, rhs, x);
+    const PlainCgOutcome cg = plain_conjugate_gradient(system, rhs, x, kPaperCgTolerance, kPaperCgMaxIterations);
     solution.iterations = cg.iterations;
     if (!(cg.relative_residual <= kPaperCgTolerance) || !x.allFinite())
       throw ComputeError(fmt::format("paper CG on the eigenvalue system did not converge: relative residual {:.3g} after {} "
