@@ -40,40 +40,71 @@ EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const
 EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFrame>& frames,
                                                  const std::vector<EigenvalueTarget>& targets, EigenvalueSolver solver,
                                                  const std::vector<Vec3>& warm_start) {
-  const Eigen::Index n = 3 * static_cast<Eigen::Index>(volume_.cell_count());
   for (const EigenvalueTarget& t : targets)
     if (t.cell < 0 || t.cell >= volume_.cell_count())
       throw InputError(fmt::format("eigenvalue target names cell {}; expected 0 to {}", t.cell, volume_.cell_count() - 1));
+  EigenvalueSolution solution;
+  try {
+    solution = weights_.equilibrium == 0.0 && solver == EigenvalueSolver::cholesky ? solve_scalar(targets, warm_start)
+                                                                                   : solve_coupled(frames, targets, solver, warm_start);
+  } catch (const ComputeError& e) {
+    throw ComputeError(fmt::format("eigenvalue interpolation: {}", e.what()));
+  }
+  for (std::size_t c = 0; c < solution.eigenvalues_kPa.size(); ++c)
+    if (!solution.eigenvalues_kPa[c].allFinite())
+      throw ComputeError(fmt::format("eigenvalue interpolation: the eigenvalues of cell {} are not finite ({}, {}, {} kPa); "
+                                     "expected finite stresses (are the control point values and frames finite?)",
+                                     c, solution.eigenvalues_kPa[c][0], solution.eigenvalues_kPa[c][1],
+                                     solution.eigenvalues_kPa[c][2]));
+  return solution;
+}
+
+void EigenvalueInterpolator::solve_with_kept_factor(const Eigen::SparseMatrix<double>& system, const Eigen::MatrixXd& rhs,
+                                                    Eigen::MatrixXd& x, int& iterations) {
+  if (cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
+    iterations = cholesky_.last_iterations();
+    return;
+  }
+  iterations = cholesky_.last_iterations();
+  cholesky_.factorize(system);
+  ++factorizations_;
+  x = cholesky_.solve_refined(system, rhs);
+}
+
+EigenvalueSolution EigenvalueInterpolator::solve_scalar(const std::vector<EigenvalueTarget>& targets,
+                                                        const std::vector<Vec3>& warm_start) {
+  // Three independent fields: (w_L L^T L + constraints) Lambda = B, Lambda n_c x 3. The matrix
+  // depends only on which cells hold control points, the right-hand side on their values.
+  const CellId cells = volume_.cell_count();
   std::vector<CellId> constrained;
   for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
   const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
-
-  if (weights_.equilibrium == 0.0 && solver == EigenvalueSolver::cholesky) {
-    // Three independent fields: (w_L L^T L + constraints) Lambda = B, Lambda n_c x 3.
-    const CellId cells = volume_.cell_count();
-    Eigen::SparseMatrix<double> system = scalar_smoothness_;
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(cells, 3);
-    for (const EigenvalueTarget& t : targets) {
-      system.coeffRef(t.cell, t.cell) += weights_.constraint;
-      rhs.row(t.cell) += weights_.constraint * t.eigenvalues_kPa.transpose();
-    }
-    for (CellId c = 0; c < cells; ++c)
-      if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // no control point -> 0
-    system.makeCompressed();
-    Eigen::MatrixXd x = Eigen::MatrixXd::Zero(cells, 3);
-    if (static_cast<Eigen::Index>(warm_start.size()) == cells)
-      for (CellId c = 0; c < cells; ++c) x.row(c) = warm_start[static_cast<std::size_t>(c)].transpose();
-    if (!cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
-      cholesky_.factorize(system);
-      ++factorizations_;
-      x = cholesky_.solve_refined(system, rhs);
-    }
-    EigenvalueSolution solution;
-    solution.eigenvalues_kPa.resize(static_cast<std::size_t>(cells));
-    for (CellId c = 0; c < cells; ++c) solution.eigenvalues_kPa[static_cast<std::size_t>(c)] = x.row(c).transpose();
-    return solution;
+  Eigen::SparseMatrix<double> system = scalar_smoothness_;
+  Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(cells, 3);
+  for (const EigenvalueTarget& t : targets) {
+    system.coeffRef(t.cell, t.cell) += weights_.constraint;
+    rhs.row(t.cell) += weights_.constraint * t.eigenvalues_kPa.transpose();
   }
+  for (CellId c = 0; c < cells; ++c)
+    if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // no control point -> 0
+  system.makeCompressed();
+  Eigen::MatrixXd x = Eigen::MatrixXd::Zero(cells, 3);
+  if (static_cast<Eigen::Index>(warm_start.size()) == cells)
+    for (CellId c = 0; c < cells; ++c) x.row(c) = warm_start[static_cast<std::size_t>(c)].transpose();
+  EigenvalueSolution solution;
+  solve_with_kept_factor(system, rhs, x, solution.iterations);
+  solution.eigenvalues_kPa.resize(static_cast<std::size_t>(cells));
+  for (CellId c = 0; c < cells; ++c) solution.eigenvalues_kPa[static_cast<std::size_t>(c)] = x.row(c).transpose();
+  return solution;
+}
 
+EigenvalueSolution EigenvalueInterpolator::solve_coupled(const std::vector<DirectionFrame>& frames,
+                                                         const std::vector<EigenvalueTarget>& targets, EigenvalueSolver solver,
+                                                         const std::vector<Vec3>& warm_start) {
+  const Eigen::Index n = 3 * static_cast<Eigen::Index>(volume_.cell_count());
+  std::vector<CellId> constrained;
+  for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
+  const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
   Eigen::SparseMatrix<double> system = smoothness_;
   if (weights_.equilibrium > 0.0) {
     const double h = volume_.grid().cell_size_mm;
@@ -96,22 +127,14 @@ EigenvalueSolution EigenvalueInterpolator::solve(const std::vector<DirectionFram
   system.makeCompressed();
 
   EigenvalueSolution solution;
-  Vector x;
+  Vector x = Vector::Zero(n);
+  if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)
+    for (std::size_t c = 0; c < warm_start.size(); ++c) x.segment<3>(3 * static_cast<Eigen::Index>(c)) = warm_start[c];
   if (solver == EigenvalueSolver::cholesky) {
-    Eigen::MatrixXd start = Eigen::MatrixXd::Zero(n, 1);
-    if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)
-      for (std::size_t c = 0; c < warm_start.size(); ++c) start.block<3, 1>(3 * static_cast<Eigen::Index>(c), 0) = warm_start[c];
-    if (cholesky_.solve_with_current_factor(system, rhs, start, kReuseTolerance, kMaxReuseIterations)) {
-      x = start.col(0);
-    } else {
-      cholesky_.factorize(system);
-      ++factorizations_;
-      x = cholesky_.solve_refined(system, rhs);
-    }
+    Eigen::MatrixXd start = x;
+    solve_with_kept_factor(system, rhs, start, solution.iterations);
+    x = start.col(0);
   } else {
-    x = Vector::Zero(n);
-    if (static_cast<Eigen::Index>(3 * warm_start.size()) == n)
-      for (std::size_t c = 0; c < warm_start.size(); ++c) x.segment<3>(3 * static_cast<Eigen::Index>(c)) = warm_start[c];
     const PlainCgOutcome cg = plain_conjugate_gradient(system, rhs, x, kPaperCgTolerance, kPaperCgMaxIterations);
     solution.iterations = cg.iterations;
     if (!(cg.relative_residual <= kPaperCgTolerance) || !x.allFinite())

@@ -9,13 +9,20 @@
 //   EigenvalueSolution s = interp.solve(frames, targets, EigenvalueSolver::cholesky, warm_start);
 //
 // Solvers: `cholesky` (default): CHOLMOD supernodal Cholesky; the factor is kept between calls
-// (the pattern of A^T A depends only on the topology): after an edit it preconditions CG on the
-// new system from `warm_start`, and the new system is factorized only when that CG needs more
-// than kMaxReuseIterations. Without the equilibrium rows (w_E = 0) the three eigenvalue fields
-// are independent: one scalar system of n_c unknowns with three right-hand sides (a third of the
-// unknowns, a factor about 4 times smaller than the coupled 3 n_c system). `paper_cg`: the
-// paper's plain CG on A^T A (one thread, no preconditioner), started from `warm_start` when it
-// has the right size, to relative residual 1e-12; ComputeError when it does not get there.
+// (the pattern of A^T A depends only on the topology). After an edit:
+//   - same matrix, other right-hand side (a control point's values changed): one refined solve
+//     with the kept factor;
+//   - other matrix values (a control point added, moved or deleted: a few diagonal entries, a
+//     low-rank change; or, with w_E > 0, new frames): CG preconditioned with the kept factor from
+//     `warm_start`; the new system is factorized only when that CG would cost more than a new
+//     factor (SparseCholesky::solve_with_current_factor projects it from the residual's rate).
+// Without the equilibrium rows (w_E = 0, the default) the three eigenvalue fields are
+// independent and do not depend on the frames: one scalar system of n_c unknowns with three
+// right-hand sides (a third of the unknowns, a factor about 4 times smaller than the coupled
+// 3 n_c system). `paper_cg`: the paper's plain CG on the coupled A^T A (one thread, no
+// preconditioner), started from `warm_start` when it has the right size, to relative residual
+// 1e-12; ComputeError when it does not get there.
+// Never returns a non-finite eigenvalue: ComputeError "eigenvalue interpolation: ..." instead.
 #include <vector>
 
 #include "cleave/grid/linked_volume.hpp"
@@ -29,7 +36,7 @@ namespace cleave {
 
 struct EigenvalueSolution {
   std::vector<Vec3> eigenvalues_kPa;  ///< per cell: Langer, cross, normal
-  int iterations = 0;                 ///< CG iterations (0 for Cholesky)
+  int iterations = 0;                 ///< CG iterations (plain CG; for `cholesky`, CG with the kept factor, 0 = direct)
 };
 
 class EigenvalueInterpolator {
@@ -39,11 +46,18 @@ class EigenvalueInterpolator {
   EigenvalueSolution solve(const std::vector<DirectionFrame>& frames, const std::vector<EigenvalueTarget>& targets,
                            EigenvalueSolver solver, const std::vector<Vec3>& warm_start = {});
   static constexpr double kReuseTolerance = 1e-13;  ///< relative residual of the CG with the kept factor
-  static constexpr int kMaxReuseIterations = 40;
+  /// Hard cap of the CG with the kept factor; it usually gives up earlier, on its cost estimate.
+  static constexpr int kMaxReuseIterations = 400;
   /// Numeric factorizations done so far by the `cholesky` solver.
   int factorizations() const { return factorizations_; }
 
  private:
+  EigenvalueSolution solve_scalar(const std::vector<EigenvalueTarget>& targets, const std::vector<Vec3>& warm_start);
+  EigenvalueSolution solve_coupled(const std::vector<DirectionFrame>& frames, const std::vector<EigenvalueTarget>& targets,
+                                   EigenvalueSolver solver, const std::vector<Vec3>& warm_start);
+  /// x: the warm start on entry, the solution on exit; iterations: CG iterations with the kept factor.
+  void solve_with_kept_factor(const Eigen::SparseMatrix<double>& system, const Eigen::MatrixXd& rhs, Eigen::MatrixXd& x,
+                              int& iterations);
   const LinkedVolume& volume_;
   DesignWeights weights_;
   std::vector<VertexId> held_vertices_;

@@ -4,18 +4,34 @@
 #include "cleave/stress/sparse_cholesky.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <chrono>
 #include <cmath>
+#include <limits>
 #include <vector>
 
 #include "cleave/core/error.hpp"
 
 namespace cleave {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
+
+/// CG with the kept factor projects its remaining work only from this iteration on (a low-rank
+/// edit of rank k converges in about k + 1 iterations, with a residual that need not fall before).
+constexpr int kFirstProjectedIteration = 4;
+
+}  // namespace
 
 struct SparseCholesky::Impl {
   Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
   std::vector<int> outer;
   std::vector<int> inner;
   bool analyzed = false;
+  std::vector<double> values;     ///< the factorized matrix's values (pattern: outer, inner)
+  double factor_seconds = 0;      ///< wall time of the last numeric factorization
+  double solve_seconds = 0;       ///< wall time of one solve with the factor (one column), last measured
 
   bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
     if (!analyzed || static_cast<std::size_t>(a.outerSize() + 1) != outer.size()) return false;
@@ -43,11 +59,22 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
     impl_->inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + impl_->outer.back());
     impl_->analyzed = true;
   }
+  const Clock::time_point start = Clock::now();
   impl_->llt.factorize(a);
   if (impl_->llt.info() != Eigen::Success) {
     impl_->analyzed = false;
+    impl_->values.clear();
     throw ComputeError("sparse Cholesky factorization failed: the design system is not positive definite");
   }
+  impl_->factor_seconds = seconds_between(start, Clock::now());
+  impl_->values.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
+}
+
+bool SparseCholesky::factor_is_of(const Eigen::SparseMatrix<double>& a) const {
+  if (!impl_->same_pattern(a) || impl_->values.size() != static_cast<std::size_t>(a.nonZeros())) return false;
+  for (std::size_t i = 0; i < impl_->values.size(); ++i)
+    if (impl_->values[i] != a.valuePtr()[i]) return false;
+  return true;
 }
 
 Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const {
@@ -61,7 +88,16 @@ Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>&
 
 bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b,
                                                Eigen::MatrixXd& x, double relative_tolerance, int max_iterations) const {
+  last_iterations_ = 0;
   if (!impl_->analyzed || !impl_->same_pattern(a) || x.rows() != b.rows() || x.cols() != b.cols()) return false;
+  if (factor_is_of(a)) {  // only the right-hand side changed: the factor is exact
+    x = solve_refined(a, b);
+    return true;
+  }
+  // Giving up costs a factorization and a refined solve of every column.
+  const double refactor_seconds =
+      impl_->factor_seconds + static_cast<double>(b.cols()) * (kRefinementSteps + 1) * impl_->solve_seconds;
+  const Clock::time_point start = Clock::now();
   for (Eigen::Index col = 0; col < b.cols(); ++col) {
     const double b_norm = b.col(col).norm();
     if (b_norm == 0.0) {
@@ -70,7 +106,8 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
     }
     Eigen::VectorXd xc = x.col(col);
     Eigen::VectorXd r = b.col(col) - a * xc;
-    if (r.norm() <= relative_tolerance * b_norm) continue;
+    const double r0_norm = r.norm();
+    if (r0_norm <= relative_tolerance * b_norm) continue;
     Eigen::VectorXd z = impl_->llt.solve(r);
     Eigen::VectorXd p = z;
     double rz = r.dot(z);
@@ -82,11 +119,20 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       const double alpha = rz / curvature;
       xc += alpha * p;
       r -= alpha * ap;
-      converged = r.norm() <= relative_tolerance * b_norm;
+      ++last_iterations_;
+      const double r_norm = r.norm();
+      converged = r_norm <= relative_tolerance * b_norm;
       if (converged) break;
-      // Off track for a geometric rate (a stroke edit changes hundreds of rows: CG stalls near
-      // 1e-5): give up early so the caller's factorization is not preceded by wasted solves.
-      if (it + 1 == max_iterations / 4 && r.norm() > std::sqrt(relative_tolerance) * b_norm) return false;
+      if (it + 1 >= kFirstProjectedIteration) {
+        // Off track (a stroke edit of a line field changes hundreds of rows: CG stalls near 1e-5),
+        // or on track but dearer than a new factor (the coupled system after a frame change):
+        // give up so that the caller's factorization is not preceded by wasted solves.
+        const double rate = std::pow(r_norm / r0_norm, 1.0 / (it + 1));
+        const double remaining = rate < 1.0 ? std::log(relative_tolerance * b_norm / r_norm) / std::log(rate)
+                                            : std::numeric_limits<double>::infinity();
+        const double seconds_per_iteration = seconds_between(start, Clock::now()) / last_iterations_;
+        if (it + 1 + remaining > max_iterations || remaining * seconds_per_iteration > refactor_seconds) return false;
+      }
       z = impl_->llt.solve(r);
       const double rz_next = r.dot(z);
       p = z + (rz_next / rz) * p;
@@ -100,7 +146,9 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
+  const Clock::time_point start = Clock::now();
   Eigen::MatrixXd x = impl_->llt.solve(b);
+  if (b.cols() > 0) impl_->solve_seconds = seconds_between(start, Clock::now()) / static_cast<double>(b.cols());
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())
     throw ComputeError("sparse Cholesky solve failed or produced a non-finite value");
   return x;

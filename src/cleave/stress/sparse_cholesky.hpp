@@ -27,16 +27,24 @@ class SparseCholesky {
   /// matrix): the design systems (L^T L, condition ~ n^2) lose digits in a plain solve.
   Eigen::MatrixXd solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const;
   static constexpr int kRefinementSteps = 2;
-  /// Solves a x = b for a matrix `a` with the pattern of the factorized one but other values
-  /// (a design edit), by conjugate gradients preconditioned with the current factor, column by
-  /// column, starting from x (the previous solution). An edit that changes a few constraint rows
-  /// is a low-rank change, so CG needs about as many iterations as the rank of the change and no
-  /// new factorization is needed. Returns true when every column reached
-  /// ||b - a x|| <= relative_tolerance ||b|| within max_iterations; false (x unspecified) when
-  /// there is no factor, the pattern differs, or CG did not get there (it stops after a quarter of
-  /// max_iterations when the residual is still above sqrt(relative_tolerance)): then factorize(a).
+  /// Solves a x = b for a matrix `a` with the pattern of the factorized one, starting from x (the
+  /// previous solution). When `a` has exactly the values of the factorized matrix (an edit that
+  /// changed only the right-hand side) this is one refined solve with the factor. Otherwise (a
+  /// design edit changed some values) it runs conjugate gradients preconditioned with the kept
+  /// factor, column by column: an edit that changes a few constraint rows is a low-rank change, so
+  /// CG needs about as many iterations as the rank of the change and no new factorization is
+  /// needed. CG gives up as soon as it is cheaper to factorize: from its 4th iteration on it
+  /// projects its remaining iterations from the residual's mean rate and stops when their
+  /// measured cost exceeds that of the last factorization plus a refined solve, or when they
+  /// would exceed max_iterations. Returns true when every column reached
+  /// ||b - a x|| <= relative_tolerance ||b||; false (x unspecified) when there is no factor, the
+  /// pattern differs, or CG gave up: then factorize(a).
   bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
                                  double relative_tolerance, int max_iterations) const;
+  /// Whether the factor is of exactly `a` (same pattern and values).
+  bool factor_is_of(const Eigen::SparseMatrix<double>& a) const;
+  /// Preconditioned CG iterations run by the last solve_with_current_factor (all columns).
+  int last_iterations() const { return last_iterations_; }
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 
@@ -44,6 +52,7 @@ class SparseCholesky {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   int reused_ = 0;
+  mutable int last_iterations_ = 0;
 };
 
 }  // namespace cleave

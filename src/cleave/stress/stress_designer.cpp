@@ -31,6 +31,14 @@ void check_weights(const DesignWeights& w) {
   check(w.equilibrium, "equilibrium", false);
 }
 
+bool same_control_points(const std::vector<DesignControlPoint>& a, const std::vector<DesignControlPoint>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].position_mm != b[i].position_mm || a[i].langer_kPa != b[i].langer_kPa || a[i].cross_kPa != b[i].cross_kPa)
+      return false;
+  return true;
+}
+
 bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
@@ -121,8 +129,16 @@ void StressDesigner::set_design(StressDesign design) {
   // Work on a copy: a failing edit leaves the designer as it was.
   DesignResult next = result_;
   next.timings = {};
-  if (!same_strokes(design.strokes, design_.strokes)) update_directions(design, next);
-  update_eigenvalues(design, next);
+  const bool strokes_changed = !same_strokes(design.strokes, design_.strokes);
+  if (strokes_changed) update_directions(design, next);
+  // The eigenvalues depend on the frames only through the equilibrium rows (w_E > 0).
+  const bool frames_matter = design.weights.equilibrium > 0.0;
+  if (!same_control_points(design.control_points, design_.control_points) || design.solver != design_.solver ||
+      (strokes_changed && frames_matter)) {
+    update_eigenvalues(design, next);
+  } else {
+    next.eigenvalue_iterations = 0;
+  }
   finish(design, next);
   result_ = std::move(next);
   design_ = std::move(design);

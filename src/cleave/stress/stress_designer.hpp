@@ -2,8 +2,10 @@
 // The residual stress design of one tissue model, kept up to date while the user edits
 // (issue 4, items 1 to 7). It holds the model's operators (Laplacians, T, its norm, the surface
 // normal field, symbolic factorizations) so that each edit only redoes what depends on it:
-//   stroke edits          -> Langer line field, frames, eigenvalues, stress
-//   control point edits   -> eigenvalues, stress (frames are kept)
+//   stroke edits          -> Langer line field, frames, stress (and the eigenvalues when w_E > 0:
+//                            without the equilibrium rows they do not depend on the frames)
+//   control point edits   -> eigenvalues, stress (frames are kept); a change of values only is
+//                            one solve with the kept eigenvalue factor
 // Warm start: every factorization (Langer field, eigenvalues, the equilibration's Kc) is kept;
 // after an edit it preconditions CG on the edited system from the previous solution, and a
 // system is refactorized only when that CG is off track (stroke edits of the Langer field). The
@@ -30,7 +32,7 @@ namespace cleave {
 /// Wall-clock time of each step of the last update (s); 0 for steps that were not redone.
 struct DesignTimings {
   double directions_s = 0;    ///< stroke targets, Langer field, orthonormal frames
-  double eigenvalues_s = 0;   ///< eigenvalue least squares
+  double eigenvalues_s = 0;   ///< eigenvalue least squares (0 when an edit cannot change them)
   double equilibration_s = 0; ///< exact equilibration (when enabled)
 };
 
@@ -41,7 +43,8 @@ struct DesignResult {
   std::vector<Vec6> stress_kPa;          ///< the result: designed_kPa, equilibrated when enabled
   double residual_designed = 0;          ///< ||T sigma|| / (||T||_2 ||sigma||) of designed_kPa (free vertices)
   double residual_final = 0;             ///< the same of stress_kPa
-  int eigenvalue_iterations = 0;         ///< paper CG iterations of the last solve (0 for Cholesky)
+  int eigenvalue_iterations = 0;         ///< CG iterations of the last eigenvalue solve (paper CG; for the default, CG
+                                         ///< with the kept factor, 0 = direct solve or not redone)
   DesignTimings timings;
 };
 
