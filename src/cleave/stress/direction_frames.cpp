@@ -59,6 +59,11 @@ std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_ten
                                  langer_tensors.size(), normal_tensors.size()));
   std::vector<DirectionFrame> frames(langer_tensors.size());
   tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t c) { frames[c] = direction_frame(langer_tensors[c], normal_tensors[c]); });
+  for (std::size_t c = 0; c < frames.size(); ++c)
+    if (!frames[c].langer.allFinite() || !frames[c].cross.allFinite() || !frames[c].normal.allFinite())
+      throw ComputeError(fmt::format("direction frames: the frame of cell {} is not finite; expected finite Langer and normal "
+                                     "tensors",
+                                     c));
   return frames;
 }
 

@@ -23,6 +23,7 @@ struct DirectionFrame {
 };
 
 /// One frame per cell; both inputs hold one symmetric tensor per cell (same size, else InputError).
+/// A non-finite tensor gives ComputeError "direction frames: the frame of cell N is not finite; ...".
 std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Mat3>& normal_tensors);
 
 /// The frame of one cell (see above).

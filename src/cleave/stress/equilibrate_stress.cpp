@@ -3,6 +3,7 @@
 #pragma GCC diagnostic ignored "-Wnull-dereference"
 #include "cleave/stress/equilibrate_stress.hpp"
 
+#include <cmath>
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
@@ -139,6 +140,10 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
   impl_->mask(load);
   const double load_norm = load.norm();
   if (load_norm == 0.0) return result;
+  if (!std::isfinite(load_norm))
+    throw ComputeError(fmt::format("stress equilibration: the forces T sigma_d of the designed stress are not finite "
+                                   "(norm {}); expected stresses of finite magnitude in kPa",
+                                   load_norm));
   if (!impl_->factorized) impl_->factorize();
   result.refinement_steps = impl_->solve(-load);
 
@@ -149,6 +154,12 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
     for (int a = 0; a < kCornerCount; ++a) ue.segment<3>(3 * a) = u.segment<3>(3 * corners[static_cast<std::size_t>(a)]);
     const Mat6& d = impl_->table.of_label(volume.cell_label(c)).elasticity_kPa;
     result.stress_kPa[static_cast<std::size_t>(c)] += d * (impl_->bc * ue);
+    if (!result.stress_kPa[static_cast<std::size_t>(c)].allFinite()) {
+      impl_->u.setZero();  // do not warm-start the next call from a failed solve
+      throw ComputeError(fmt::format("stress equilibration: the stress of cell {} is not finite after {} preconditioned CG "
+                                     "iterations; expected a finite self-balanced field",
+                                     c, result.refinement_steps));
+    }
   }
   Vector remaining = residual_stress_forces(volume, result.stress_kPa);
   impl_->mask(remaining);

@@ -30,11 +30,20 @@ std::vector<Mat3> LineFieldInterpolator::interpolate(const std::vector<LineTarge
     if (pinned[static_cast<std::size_t>(c)]) system.coeffRef(c, c) += weights_.laplacian;  // piece without targets -> 0
   system.makeCompressed();
   Eigen::MatrixXd x = previous_;
-  if (!cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
-    cholesky_.factorize(system);
-    ++factorizations_;
-    x = cholesky_.solve_refined(system, rhs);
+  try {
+    if (!cholesky_.solve_with_current_factor(system, rhs, x, kReuseTolerance, kMaxReuseIterations)) {
+      cholesky_.factorize(system);
+      ++factorizations_;
+      x = cholesky_.solve_refined(system, rhs);
+    }
+  } catch (const ComputeError& e) {
+    throw ComputeError(fmt::format("line field interpolation: {}", e.what()));
   }
+  for (CellId c = 0; c < cell_count_; ++c)
+    if (!x.row(c).allFinite())
+      throw ComputeError(fmt::format("line field interpolation: the tensor of cell {} is not finite; expected finite "
+                                     "direction targets",
+                                     c));
   previous_ = x;
   std::vector<Mat3> field(static_cast<std::size_t>(cell_count_));
   for (CellId c = 0; c < cell_count_; ++c) field[static_cast<std::size_t>(c)] = from_voigt(x.row(c).transpose());

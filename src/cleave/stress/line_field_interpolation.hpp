@@ -12,7 +12,9 @@
 //   x = interp.interpolate(edited_targets);                 // no factorization: CG preconditioned
 //                                                           // by the kept factor, from the last x
 // After an edit the kept factor (of the first system) preconditions CG on the new system; only
-// when CG needs more than kMaxReuseIterations is the new system factorized.
+// when CG is off track or dearer than a new factor (at most kMaxReuseIterations) is the new
+// system factorized. Never returns a non-finite tensor: ComputeError "line field interpolation:
+// ..." instead (a non-finite target reaches here only through this internal API).
 #include <vector>
 
 #include "cleave/grid/linked_volume.hpp"
