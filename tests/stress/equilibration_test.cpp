@@ -91,14 +91,20 @@ TEST(Equilibration, DesignedStressBecomesSelfBalancedAndTheBodyStaysAtRest) {
 
 // Issue 4: the abdomen (a shell 2 to 4 cells thick, 5.7k cells) did not converge ("4.62e-07
 // after 100 steps"): its bending and one-point hourglass modes are softer than the old shift.
-TEST(Equilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest) {
+// Both designs: the default (w_E = 0, control points reproduced; on the free shell this design is
+// nearly compatible and relaxes almost completely, so the scale-free residual, relative to the small
+// final ||sigma||, is a little larger) and the paper's eq. 6 penalty (w_E = 1).
+class AbdomenEquilibration : public ::testing::TestWithParam<double> {};
+
+TEST_P(AbdomenEquilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest) {
   const TissueModel m = test::builtin_model("abdomen");
   ASSERT_GT(m.volume.cell_count(), 5000);
   StressDesign d = test::abdomen_demo_design(m);
+  d.weights.equilibrium = GetParam();
   d.equilibration = Equilibration::growth;
   const DesignResult result = design_residual_stress(m, d);
 
-  EXPECT_LT(result.residual_final, 1e-12);
+  EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 1e-11 : 1e-12);
   EXPECT_GT(result.residual_designed, 1e-2);
   const double size = m.size_mm();
   EXPECT_GT(max_displacement_mm(m, result.designed_kPa), 1e-3 * size);
@@ -112,6 +118,8 @@ TEST(Equilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest) {
   mean /= static_cast<double>(result.stress_kPa.size());
   EXPECT_LT(mean.cwiseAbs().maxCoeff(), 1e-9 * largest);
 }
+
+INSTANTIATE_TEST_SUITE_P(EquilibriumWeights, AbdomenEquilibration, ::testing::Values(0.0, 1.0));
 
 // The demo holds the wall's rim. Equilibrium is imposed at the free vertices only (paper eq. 2
 // holds on the free surface Gamma_N); the rim carries the reactions, as skin stretched over a

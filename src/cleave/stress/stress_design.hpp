@@ -29,10 +29,15 @@ struct DesignControlPoint {
 
 /// Weights of the least-squares terms (eq. 9). The equilibrium rows are T sigma / h^2 (kPa), so
 /// all three terms compare stresses and the weights need no rescaling with the cell size.
+/// Default w_E = 0: the design interpolates the control points as the user set them and the
+/// exact equilibration (default on) balances it. The eq. 6 penalty (w_E > 0, the paper's form)
+/// is kept: on a thin curved shell it pulls the eigenvalues to ~0 away from the control points
+/// (the only field it can balance everywhere), and it makes the eigenvalue system depend on the
+/// frames, so every stroke edit changes it (docs/stress-design.md).
 struct DesignWeights {
   double laplacian = 1.0;      ///< smoothness, L lambda = 0 (eq. 7)
   double constraint = 1000.0;  ///< strokes and control points, C lambda = lambda0 (eq. 8)
-  double equilibrium = 1.0;    ///< T (d sigma / d lambda) lambda = 0 (eq. 6); 0 = off
+  double equilibrium = 0.0;    ///< T (d sigma / d lambda) lambda = 0 (eq. 6); 0 = off (default)
 };
 
 /// How the eigenvalue normal equations A^T A lambda = A^T b are solved.
@@ -43,10 +48,12 @@ enum class EigenvalueSolver {
 
 /// Where the equilibrium equations hold (paper eqs. 1, 2: sigma n = 0 only on the free surface
 /// Gamma_N). The held vertices (Gamma_D, e.g. the rim of the demo's abdominal wall) may carry
-/// reactions, so the eq. 6 rows and the exact equilibration skip them.
+/// reactions, so the eq. 6 rows and the exact equilibration skip them. Default `simulation`:
+/// the design is balanced on the body the simulation deforms; a case that holds nothing is a
+/// free body, where both choices are the same (every vertex balanced, mean stress 0).
 enum class EquilibriumSupport {
   none,        ///< free body: equilibrium at every vertex (Hoger: mean stress 0)
-  simulation,  ///< the vertices that the case's "simulation" section holds (stage_residual_stress)
+  simulation,  ///< default: the vertices that the case's "simulation" section holds (stage_residual_stress)
 };
 
 /// Whether the designed field is made exactly self-balanced afterwards (equilibrate_stress.hpp).
@@ -61,7 +68,7 @@ struct StressDesign {
   DesignWeights weights;
   EigenvalueSolver solver = EigenvalueSolver::cholesky;
   Equilibration equilibration = Equilibration::growth;
-  EquilibriumSupport support = EquilibriumSupport::none;
+  EquilibriumSupport support = EquilibriumSupport::simulation;
   /// Held vertices (uncut model's vertex ids) where equilibrium is not imposed; empty = free body.
   /// Filled from the simulation section when support == simulation; may be set directly.
   std::vector<VertexId> held_vertices;
