@@ -41,8 +41,8 @@ TEST(CaseDesign, ParsesEveryField) {
   const StressDesign d = parse_design_json(nlohmann::json::parse(R"({
       "strokes": [{"points": [[0,0,10],[10,0,10]]}, {"points": [[1,1,5],[2,2,5]], "interior": true}],
       "control_points": [{"position": [5,5,10], "langer_kPa": 20, "cross_kPa": 10}],
-      "weights": {"laplacian": 2, "constraint": 50, "equilibrium": 0},
-      "equilibrate": false, "equilibrium_support": "simulation", "solver": "paper-cg", "snap_tolerance_cells": 3})"),
+      "weights": {"laplacian": 2, "constraint": 50, "equilibrium": 3},
+      "equilibrate": false, "equilibrium_support": "none", "solver": "paper-cg", "snap_tolerance_cells": 3})"),
                                            JsonPath{"case.json", "/design"});
   ASSERT_EQ(d.strokes.size(), 2u);
   EXPECT_EQ(d.strokes[0].placement, StrokePlacement::surface);
@@ -52,11 +52,26 @@ TEST(CaseDesign, ParsesEveryField) {
   EXPECT_EQ(d.control_points[0].langer_kPa, 20);
   EXPECT_EQ(d.weights.laplacian, 2);
   EXPECT_EQ(d.weights.constraint, 50);
-  EXPECT_EQ(d.weights.equilibrium, 0);
+  EXPECT_EQ(d.weights.equilibrium, 3);
   EXPECT_EQ(d.equilibration, Equilibration::none);
-  EXPECT_EQ(d.support, EquilibriumSupport::simulation);
+  EXPECT_EQ(d.support, EquilibriumSupport::none);
   EXPECT_EQ(d.solver, EigenvalueSolver::paper_cg);
   EXPECT_EQ(d.snap_tolerance_cells, 3);
+}
+
+// The default mode (docs/stress-design.md): no equilibrium term in the least squares (the control
+// points are reproduced), exact equilibration, equilibrium where the simulation leaves the body free.
+TEST(CaseDesign, DefaultsReproduceTheControlPointsAndBalanceOnTheSimulatedBody) {
+  const StressDesign d = parse_design_json(
+      nlohmann::json::parse(R"({"control_points": [{"position": [5,5,10], "langer_kPa": 20, "cross_kPa": 10}]})"),
+      JsonPath{"case.json", "/design"});
+  EXPECT_EQ(d.weights.laplacian, 1);
+  EXPECT_EQ(d.weights.constraint, 1000);
+  EXPECT_EQ(d.weights.equilibrium, 0);
+  EXPECT_EQ(d.equilibration, Equilibration::growth);
+  EXPECT_EQ(d.support, EquilibriumSupport::simulation);
+  EXPECT_EQ(d.solver, EigenvalueSolver::cholesky);
+  EXPECT_EQ(d.snap_tolerance_cells, 2);
 }
 
 TEST(CaseDesign, BadInputNamesThePath) {

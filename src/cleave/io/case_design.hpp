@@ -5,16 +5,19 @@
 //   "design": {
 //     "strokes": [ {"points": [[x, y, z], ...], "interior": false}, ... ],   mm; >= 2 points each
 //     "control_points": [ {"position": [x, y, z], "langer_kPa": 20, "cross_kPa": 10}, ... ],  >= 1
-//     "weights": {"laplacian": 1, "constraint": 1000, "equilibrium": 1},       optional, defaults shown
+//     "weights": {"laplacian": 1, "constraint": 1000, "equilibrium": 0},       optional, defaults shown
 //     "equilibrate": true,                                                     optional, default true
-//     "equilibrium_support": "none" | "simulation",                            optional, default "none"
+//     "equilibrium_support": "simulation" | "none",                            optional, default "simulation"
 //     "solver": "default" | "paper-cg",                                        optional, default "default"
 //     "snap_tolerance_cells": 2                                                optional, > 0
 //   }
 //
 // "equilibrium_support": "simulation" imposes equilibrium (eq. 6 rows and the exact equilibration)
 // only at the vertices that "simulation"/"fixed" leaves free: the held ones carry reactions, as
-// tissue stretched over a frame (paper eq. 2 holds on the free surface only). "none": free body.
+// tissue stretched over a frame (paper eq. 2 holds on the free surface only); a case that holds
+// nothing is a free body either way. "none": balance as a free body even where the case holds it.
+// Defaults (w_E = 0, equilibrate, support from the simulation): the control points are reproduced
+// and the exact equilibration balances the field (docs/stress-design.md says why).
 // "interior": true marks a stroke inside the body (not snapped). Errors are InputErrors naming the
 // file, JSON path, value and expectation, e.g.
 //   "case.json: /design/strokes/2/points is [[0,0,0]]; expected at least two points".
