@@ -49,9 +49,10 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(defaults.mode, SimulationMode::static_equilibrium);
   EXPECT_EQ(defaults.solver, SolverKind::multigrid_cg);
   EXPECT_TRUE(defaults.fixed_boxes.empty());
+  EXPECT_EQ(defaults.numerical_damping, 0.2);
   const SimulationSettings s = parse_simulation_settings(case_from(
       R"(, "simulation": {"mode": "dynamic", "solver": "cholmod", "tolerance": 1e-9, "time_step_s": 0.002, "steps": 50,
-          "steps_per_frame": 5, "frames_every": 2, "damping": {"mass_per_s": 3, "stiffness_s": 0.01},
+          "steps_per_frame": 5, "frames_every": 2, "damping": {"mass_per_s": 3, "stiffness_s": 0.01, "numerical": 0},
           "fixed": [{"box_mm": [[0, 0, 0], [1, 100, 10]]}], "gravity_mm_per_s2": [0, 0, -9810]})"));
   EXPECT_EQ(s.mode, SimulationMode::dynamic);
   EXPECT_EQ(s.solver, SolverKind::cholmod);
@@ -62,6 +63,7 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(s.frames_every, 2);
   EXPECT_EQ(s.mass_damping_per_s, 3.0);
   EXPECT_EQ(s.stiffness_damping_s, 0.01);
+  EXPECT_EQ(s.numerical_damping, 0.0);
   ASSERT_EQ(s.fixed_boxes.size(), 1u);
   EXPECT_EQ(s.fixed_boxes[0].hi_mm, Vec3(1, 100, 10));
   EXPECT_EQ(s.gravity_mm_per_s2, Vec3(0, 0, -9810));
@@ -72,6 +74,8 @@ TEST(CaseMechanics, BadSimulationFieldsAreNamed) {
             "case.json: /simulation/time_step_s is -1; expected a positive time step in s");
   EXPECT_EQ(simulation_error(R"({"time_step_s": 0})"),
             "case.json: /simulation/time_step_s is 0; expected a positive time step in s");
+  EXPECT_EQ(simulation_error(R"({"damping": {"numerical": 0.5}})"),
+            "case.json: /simulation/damping/numerical is 0.5; expected a numerical damping (HHT -alpha) from 0 to 1/3");
   EXPECT_EQ(simulation_error(R"({"steps": 0})"), "case.json: /simulation/steps is 0; expected an integer from 1 to 100000000");
   EXPECT_EQ(simulation_error(R"({"mode": "quasi"})"), "case.json: /simulation/mode is \"quasi\"; expected \"static\" or \"dynamic\"");
   EXPECT_EQ(simulation_error(R"({"solver": "lu"})"),

@@ -23,6 +23,8 @@ Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_k
   if (!(settings_.mass_damping_per_s >= 0) || !(settings_.stiffness_damping_s >= 0))
     throw InputError(fmt::format("damping is alpha {} 1/s, beta {} s; expected non-negative numbers",
                                  settings_.mass_damping_per_s, settings_.stiffness_damping_s));
+  if (!(settings_.numerical_damping >= 0 && settings_.numerical_damping <= 1.0 / 3.0))
+    throw InputError(fmt::format("numerical damping is {}; expected a number from 0 to 1/3", settings_.numerical_damping));
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (settings_.external_force_mN.size() != 0 && settings_.external_force_mN.size() != dofs)
     throw InputError(fmt::format("external force holds {} values; expected {} (3 per vertex)", settings_.external_force_mN.size(), dofs));
@@ -83,6 +85,11 @@ void Dynamics::topology_changed(const CutReport& report) {
         fixed_[static_cast<std::size_t>(3 * v + i)] = fixed_[static_cast<std::size_t>(3 * split.original + i)];
     }
   rebuild_topology();
+  // Positions and velocities are continuous across a cut, forces are not: the cut faces lose
+  // their tractions at once. Newmark needs the acceleration that satisfies the equation of
+  // motion of the new topology; the old one (copied onto split vertices) would inject momentum
+  // (a cell cut loose under 20 kPa left at 5 m/s instead of staying in place).
+  compute_acceleration();
 }
 
 void Dynamics::set_state(const Vector& displacement_mm, const Vector& velocity_mm_per_s) {
@@ -171,22 +178,26 @@ double Dynamics::elastic_energy_uJ() const {
 
 SolveReport Dynamics::step(double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) throw InputError(fmt::format("time step is {} s; expected a positive time step in s", dt));
-  constexpr double beta = kNewmarkBeta;
-  constexpr double gamma = kNewmarkGamma;
+  const double gamma = kNewmarkGamma + settings_.numerical_damping;  // HHT with alpha = -numerical_damping
+  const double beta = 0.25 * (1.0 + settings_.numerical_damping) * (1.0 + settings_.numerical_damping);
   const double alpha_m = settings_.mass_damping_per_s;
   const double beta_k = settings_.stiffness_damping_s;
 
   update_rotations();
   assemble_rotated_stiffness();
-  const double c_mass = 1.0 / (beta * dt * dt) + alpha_m * gamma / (beta * dt);
-  const double c_stiff = 1.0 + beta_k * gamma / (beta * dt);
+  // HHT: M a(n+1) + w [D v(n+1) + f_int(n+1)] + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - a,
+  // with f_int(n+1) ~ f_int(n) + K_R du (R frozen over the step) and v(n+1) = gamma du / (beta dt) + damping_part.
+  const double w = 1.0 - settings_.numerical_damping;
+  const double c_mass = 1.0 / (beta * dt * dt) + w * alpha_m * gamma / (beta * dt);
+  const double c_stiff = w * (1.0 + beta_k * gamma / (beta * dt));
 
   // Velocity-like combinations of the old state that enter the increment equation.
   const Vector inertia_part = v_ / (beta * dt) + (0.5 / beta - 1.0) * a_;
   const Vector damping_part = (1.0 - gamma / beta) * v_ + dt * (1.0 - 0.5 * gamma / beta) * a_;
   Vector rhs = external_forces() - internal_forces() + mass_.cwiseProduct(inertia_part);
-  if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damping_part);
-  if (beta_k > 0) rhs -= beta_k * (stiffness_ * damping_part);
+  const Vector damped_velocity = w * damping_part + (1.0 - w) * v_;
+  if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damped_velocity);
+  if (beta_k > 0) rhs -= beta_k * (stiffness_ * damped_velocity);
 
   {
     const double* k = stiffness_.valuePtr();
@@ -224,6 +235,12 @@ SolveReport Dynamics::step(double dt) {
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }
   if (!du.allFinite()) throw ComputeError(fmt::format("dynamic step with {} produced a non-finite displacement", solver_->name()));
+  const double size_mm = model_.volume.grid().cell_size_mm * model_.volume.grid().dims.cast<double>().norm();
+  const double largest_mm = (u_ + du).lpNorm<Eigen::Infinity>();
+  if (largest_mm > kDivergedSizes * size_mm)
+    throw ComputeError(fmt::format("dynamic step at t = {:.6g} s diverged: a vertex moved {:.3g} mm, more than {:g} times the "
+                                   "model's size ({:.3g} mm); add damping (simulation.damping) or use a smaller time step",
+                                   time_s_, largest_mm, kDivergedSizes, size_mm));
 
   const Vector a_new = du / (beta * dt * dt) - v_ / (beta * dt) - (0.5 / beta - 1.0) * a_;
   v_ += dt * ((1.0 - gamma) * a_ + gamma * a_new);

@@ -51,6 +51,7 @@ struct SimulationSettings {
   int frames_every = 1;
   double mass_damping_per_s = 0;
   double stiffness_damping_s = 0;
+  double numerical_damping = 0.2;  ///< HHT -alpha (fem/dynamics.hpp)
   std::vector<FixedBox> fixed_boxes;  ///< empty (and no fixed_surfaces) = free body ("none" / "free")
   std::vector<FixedSurface> fixed_surfaces;
   Vec3 gravity_mm_per_s2 = Vec3::Zero();
