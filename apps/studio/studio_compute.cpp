@@ -6,18 +6,21 @@
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/atomic_file.hpp"
+#include "cleave/io/case_design.hpp"
 #include "cleave/io/gltf_writer.hpp"
 #include "cleave/io/ply_writer.hpp"
 #include "cleave/io/vtu_writer.hpp"
 #include "cleave/cut/place_incisions.hpp"
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/solve_static.hpp"
+#include "cleave/pipeline/held_vertices.hpp"
 #include "cleave/stress/equilibrium_operator.hpp"
 #include "cleave/stress/stroke_constraints.hpp"
 #include "cleave/viz/cut_face_colouring.hpp"
 #include "cleave/viz/incision_ellipses.hpp"
 #include "cleave/viz/streamlines.hpp"
 #include "cleave/viz/wound_measures.hpp"
+#include "studio/finite_message.hpp"
 
 namespace cleave::studio {
 namespace {
@@ -43,6 +46,22 @@ constexpr int kStreamlineMaxSteps = 40;   ///< half cells per direction
 double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std::milli>(Clock::now() - t0).count(); }
 
 
+/// The design settings of the session's case (weights, equilibration, equilibrium support,
+/// solver, snap tolerance), without strokes or control points: the library's defaults when the
+/// case has no "design" section. The studio edits the strokes and points itself.
+StressDesign design_settings(const CaseFile& case_file) {
+  const nlohmann::json* section = case_file.section("design");
+  if (!section || !section->is_object()) return StressDesign{};
+  nlohmann::json settings = *section;
+  settings["strokes"] = nlohmann::json::array();
+  // parse_design_json asks for a control point (a case without one would design nothing); the
+  // studio's come from its own edits, so a placeholder stands in and is dropped.
+  settings["control_points"] = {{{"position", {0, 0, 0}}, {"langer_kPa", 0}, {"cross_kPa", 0}}};
+  StressDesign d = parse_design_json(settings, case_file.at("design"));
+  d.control_points.clear();
+  return d;
+}
+
 /// Rounds to `step` (mm, kPa): the page does not need more and the messages stay small.
 double rounded_to(double v, double step) { return std::round(v / step) * step; }
 
@@ -67,10 +86,13 @@ std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const
 }
 
 /// The equilibrium residual |T sigma| / h^2 (kPa) at each surface vertex: the force left at the
-/// uncut model's vertex of the surface vertex's grid corner, as a stress.
+/// uncut model's vertex of the surface vertex's grid corner, as a stress; 0 at `held` vertices
+/// (their force is the support's reaction).
 std::vector<float> residual_per_surface_vertex(const LinkedVolume& volume, const SparseMatrix& divergence,
-                                               std::span<const Vec6> stress_kPa, const RenderSurface& surface) {
-  const Vector force = divergence * flatten_stress(stress_kPa);
+                                               std::span<const Vec6> stress_kPa, const RenderSurface& surface,
+                                               std::span<const VertexId> held) {
+  Vector force = divergence * flatten_stress(stress_kPa);
+  for (VertexId v : held) force.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();  // reactions, not residuals
   const double h = volume.grid().cell_size_mm;
   std::vector<float> out(static_cast<std::size_t>(surface.vertex_count()), 0.0f);
   for (std::size_t v = 0; v < out.size(); ++v) {
@@ -132,7 +154,7 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
         }
         send_(std::move(text));
       },
-      [this](nlohmann::json progress) { send_(progress.dump()); });
+      [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump()); });
 }
 
 StudioCompute::~StudioCompute() { worker_.reset(); }
@@ -151,6 +173,10 @@ void StudioCompute::prepare(const FieldWorker::Context& ctx) {
   if (body_surface_) return;
   report(ctx.progress, "preparing the model", 0.0);
   const TissueModel& model = session_.model();
+  design_settings_ = design_settings(session_.case_file());
+  simulation_ = parse_simulation_settings(session_.case_file());
+  held_uncut_ = held_vertices(model, simulation_);
+  if (design_settings_.support == EquilibriumSupport::simulation) design_settings_.held_vertices = held_uncut_;
   body_surface_ = std::make_unique<BodySurface>(model);
   const double h = model.volume.grid().cell_size_mm;
   IncisionPattern pattern;
@@ -167,7 +193,7 @@ void StudioCompute::prepare(const FieldWorker::Context& ctx) {
 const DesignResult* StudioCompute::design_fields(const DesignState& design, nlohmann::json& message,
                                                  nlohmann::json& timings) {
   const TissueModel& model = session_.model();
-  StressDesign stress_design;
+  StressDesign stress_design = design_settings_;
   for (const Stroke& s : design.strokes) stress_design.strokes.push_back({s.points_mm, StrokePlacement::surface});
   for (const ControlPoint& p : design.control_points)
     stress_design.control_points.push_back({p.position_mm, p.langer_kPa, p.cross_kPa});
@@ -176,16 +202,16 @@ const DesignResult* StudioCompute::design_fields(const DesignState& design, nloh
     return nullptr;
   }
   if (!stress_design.control_points.empty()) {
-    // Directions and magnitudes. The studio keeps the least-squares design with its equilibrium
-    // term (eq. 9) and skips the exact equilibration (one elastic solve per edit, seconds on the
-    // abdomen): the page shows the remaining residual ("Equilibrium residual" display).
-    stress_design.equilibration = Equilibration::none;
+    // Directions and magnitudes with the case's settings (on the bare abdomen the demo's: no
+    // equilibrium term, exactly equilibrated at the free vertices; the residual display shows
+    // what is left).
     try {
       if (!designer_) designer_ = std::make_unique<StressDesigner>(model, stress_design);
       else designer_->set_design(stress_design);
       const DesignResult& r = designer_->result();
       timings["directions"] = 1000.0 * r.timings.directions_s;
       timings["eigenvalues"] = 1000.0 * r.timings.eigenvalues_s;
+      if (stress_design.equilibration != Equilibration::none) timings["equilibration"] = 1000.0 * r.timings.equilibration_s;
       message["equilibrium_residual"] = {{"designed", r.residual_designed}, {"final", r.residual_final}};
       stress_kPa_ = r.stress_kPa;
       return &r;
@@ -237,6 +263,7 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
   // Measurements sample the margins on the cut body's own surface (its split vertices).
   cut_body_surface_ = plan_.incisions.empty() ? nullptr : std::make_unique<BodySurface>(*preview_model_);
+  held_cut_ = held_vertices(*preview_model_, simulation_);  // the case's supports on the cut body
   cut_key_ = key;
   return true;
 }
@@ -248,6 +275,7 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
   DynamicsSettings settings;
   settings.mass_damping_per_s = kOpeningDamping_per_s;
   settings.solver = SolverKind::cholmod;
+  settings.fixed_vertices = held_cut_;
   Dynamics sim(*preview_model_, stress_kPa_, settings);
   std::vector<std::uint32_t> triangles = visible_triangles(surface, plan_);
   double step_ms = 0;
@@ -272,7 +300,9 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     }
     if (i > 0) step_ms += ms_since(ts);
     frame["step_ms"] = i > 0 ? step_ms / i : 0.0;
+    frame = checked_outgoing(std::move(frame));
     send_(frame.dump());
+    if (frame["type"] == "error") return;  // the statics after it report the result (or its error)
   }
   timings["opening"] = ms_since(t0);
   timings["frame"] = step_ms / kOpeningFrames;
@@ -329,6 +359,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     report(ctx.progress, "opening the incisions", 0.7);
     StaticOptions options;
     options.solver = SolverKind::cholmod;
+    options.fixed_vertices = held_cut_;
     const StaticResult r = solve_static(*preview_model_, stress_kPa_, options);
     displacement_mm_ = r.displacement_mm;
     timings["incisions"] = ms_since(t);
@@ -353,11 +384,6 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     cross.push_back(static_cast<float>(fields->eigenvalues_kPa[c][1]));
   }
   message["surface"] = {{"positions_mm", float_array(positions)}, {"triangles", visible_triangles(surface, plan_)}};
-  {
-    ExportSnapshot snapshot{preview_model_, displacement_mm_, stress_kPa_, make_surface_mesh(surface, x)};
-    std::lock_guard lock(latest_mutex_);
-    latest_export_ = std::move(snapshot);
-  }
   nlohmann::json f = nlohmann::json::object();
   if (fields) f["direction"] = float_array(direction);
   if (!langer.empty()) {
@@ -366,7 +392,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   }
   if (has_stress) {
     if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
-    f["residual_kPa"] = float_array(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface));
+    f["residual_kPa"] = float_array(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices));
   }
   if (!displacement_mm_.empty()) f["displacement_mm"] = float_array(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).
@@ -393,12 +419,25 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   // 5. Measurements: incision openings and wound widths.
   nlohmann::json incisions = nlohmann::json::array();
   nlohmann::json wounds = nlohmann::json::array();
+  nlohmann::json flaps = nlohmann::json::array();
   if (!displacement_mm_.empty()) {
+    const double h = model.volume.grid().cell_size_mm;
     for (const IncisionFrame& frame : plan_.incisions) {
-      const auto m = measure_incision(*cut_body_surface_, displacement_mm_, frame, std::nullopt);
-      if (m) incisions.push_back({{"centre_mm", {frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()}},
-                                  {"opening_mm", m->opening_mm},
-                                  {"gap_mm", m->gap_mm}});
+      // The designed Langer direction under the incision is the reference of the long axis.
+      std::optional<TangentDirection> reference;
+      CellId c = model.volume.cell_containing(frame.centre_mm - 0.5 * h * frame.normal);
+      if (c == kNone) c = model.volume.cell_containing(frame.centre_mm - h * frame.normal);
+      if (c != kNone && fields) reference = TangentDirection{fields->frames[static_cast<std::size_t>(c)].langer, 1.0};
+      const auto m = measure_incision(*cut_body_surface_, displacement_mm_, frame, reference);
+      if (!m) continue;
+      nlohmann::json j = {{"centre_mm", {frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()}},
+                          {"opening_mm", m->opening_mm},
+                          {"gap_mm", m->gap_mm},
+                          {"semi_major_mm", m->outer.semi_major},
+                          {"semi_minor_mm", m->outer.semi_minor},
+                          {"axis_ratio", m->outer.axis_ratio()}};
+      if (m->langer_angle_deg) j["langer_angle_deg"] = *m->langer_angle_deg;
+      incisions.push_back(std::move(j));
     }
     std::size_t scalpel = 0;
     for (const Cut& c : design.cuts) {
@@ -406,9 +445,19 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
       const WoundWidth w = scalpel_wound_width(preview_model_->volume, displacement_mm_, plan_.scalpel_paths[scalpel++]);
       wounds.push_back({{"cut", c.id}, {"width_mm", w.max_mm}, {"mean_width_mm", w.mean_mm}});
     }
+    std::size_t flap = 0;
+    for (const Cut& c : design.cuts) {
+      if (c.kind != CutKind::flap || flap >= plan_.flaps.size()) continue;
+      const FlapChange change = flap_change(preview_model_->volume, displacement_mm_, plan_.flaps[flap++]);
+      flaps.push_back({{"cut", c.id},
+                       {"skin_area_mm2", change.skin_area_before_mm2},
+                       {"skin_area_change_percent", change.skin_area_change_percent},
+                       {"volume_change_percent", change.volume_change_percent}});
+    }
   }
   message["incisions"] = incisions;
   message["wounds"] = wounds;
+  message["flaps"] = flaps;
   const auto [lo, hi] = model.bounding_box_mm();
   message["bounding_box_mm"] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   message["cell_size_mm"] = model.volume.grid().cell_size_mm;
@@ -416,6 +465,14 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   timings["surface"] = ms_since(t);
   timings["total"] = ms_since(t0);
   message["timings_ms"] = timings;
+  // Nothing non-finite leaves the server: a NaN anywhere turns the result into an error naming
+  // its stage, and the exports keep the last good result.
+  message = checked_outgoing(std::move(message));
+  if (message["type"] == "result") {
+    ExportSnapshot snapshot{preview_model_, displacement_mm_, stress_kPa_, make_surface_mesh(surface, x)};
+    std::lock_guard lock(latest_mutex_);
+    latest_export_ = std::move(snapshot);
+  }
   return message;
 }
 

@@ -11,6 +11,7 @@
 
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/cut/cut_plan.hpp"
+#include "cleave/io/case_mechanics.hpp"
 #include "cleave/solve/linear_solver.hpp"
 #include "cleave/stress/line_field_interpolation.hpp"
 #include "cleave/stress/stress_designer.hpp"
@@ -51,6 +52,12 @@ class StudioCompute {
                       nlohmann::json& timings);
 
   // Worker-thread state (only the worker touches these).
+  /// The session case's design settings (weights, equilibration, support; no strokes or points)
+  /// and supports ("simulation"/"fixed"), read once.
+  StressDesign design_settings_;
+  SimulationSettings simulation_;
+  std::vector<VertexId> held_uncut_;                  ///< held vertices of the uncut model
+  std::vector<VertexId> held_cut_;                    ///< the same on preview_model_
   std::unique_ptr<BodySurface> body_surface_;         ///< of the uncut model
   std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
   std::unique_ptr<StressDesigner> designer_;

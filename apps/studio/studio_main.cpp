@@ -8,13 +8,15 @@
 #include "cleave/io/case_file.hpp"
 #include "studio/studio_compute.hpp"
 #include "studio/studio_server.hpp"
+#include "studio/studio_session.hpp"
 
 namespace cleave::studio {
 
 std::optional<nlohmann::json> case_for_model_argument(const std::string& model, const std::string& resolution) {
   if (model.empty() && resolution.empty()) return std::nullopt;
+  const bool case_file = !model.empty() && classify_model_source(model) == ModelSourceKind::case_file;
   nlohmann::json doc;
-  if (!model.empty() && classify_model_source(model) == ModelSourceKind::case_file) {
+  if (case_file) {
     const CaseFile c = load_case_file(model);
     doc = c.document;
     doc["model"]["source"] = c.model_source;  // resolved against the case's folder
@@ -33,7 +35,8 @@ std::optional<nlohmann::json> case_for_model_argument(const std::string& model, 
     doc["model"]["resolution"] = {std::stoi(m[1]), std::stoi(m[2]), std::stoi(m[3])};
   }
   parse_case_text(doc.dump(), model.empty() ? "--res" : model, std::filesystem::current_path());  // validates
-  return doc;
+  // A case file keeps its own settings; a bare model gets the studio's (the demo's on the abdomen).
+  return case_file ? doc : bare_model_case(doc["model"]);
 }
 
 int run_studio(const StudioMainOptions& options) {

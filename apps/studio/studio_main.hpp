@@ -22,8 +22,9 @@ struct StudioMainOptions {
 };
 
 /// The case document for the studio's MODEL argument: a case file (validated, model path made
-/// absolute), or a model name / file with an optional "NXxNYxNZ" resolution; std::nullopt when
-/// both are empty. InputError for a bad case, model or resolution.
+/// absolute; its own design and simulation settings kept), or a model name / file with an
+/// optional "NXxNYxNZ" resolution (bare_model_case: the demo's settings on the abdomen);
+/// std::nullopt when both are empty. InputError for a bad case, model or resolution.
 std::optional<nlohmann::json> case_for_model_argument(const std::string& model, const std::string& resolution);
 
 /// Serves until SIGINT / SIGTERM; returns the exit code.

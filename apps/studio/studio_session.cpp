@@ -5,6 +5,7 @@
 #include "cleave/core/error.hpp"
 #include "cleave/io/atomic_file.hpp"
 #include "cleave/io/case_file.hpp"
+#include "cleave/pipeline/demo_case.hpp"
 #include "studio/design_edit.hpp"
 #include "studio/path_safety.hpp"
 #include "studio/session_case.hpp"
@@ -23,8 +24,19 @@ std::unique_ptr<TissueModel> load_model(const CaseFile& c) {
 
 }  // namespace
 
+nlohmann::json bare_model_case(const nlohmann::json& model) {
+  nlohmann::json doc = {{"cleave_case", 1}, {"model", model}};
+  if (model.value("source", "") != "abdomen") return doc;
+  const CaseFile parsed = parse_case_text(doc.dump(), "the abdomen", std::filesystem::current_path());
+  const std::unique_ptr<TissueModel> abdomen = load_model(parsed);
+  const nlohmann::json settings = abdomen_demo_settings(*abdomen);
+  doc["design"] = settings.at("design");
+  doc["simulation"] = settings.at("simulation");
+  return doc;
+}
+
 nlohmann::json default_session_case() {
-  return {{"cleave_case", 1}, {"model", {{"source", "abdomen"}, {"resolution", {63, 21, 42}}}}};
+  return bare_model_case({{"source", "abdomen"}, {"resolution", {63, 21, 42}}});
 }
 
 StudioSession::StudioSession(std::filesystem::path folder, std::optional<nlohmann::json> case_document)
@@ -56,8 +68,8 @@ StudioSession::StudioSession(std::filesystem::path folder, std::optional<nlohman
     case_ = default_session_case();
     write_file_atomically(session_file, nlohmann::json{{"cleave_session", 1}, {"case", case_}}.dump(2) + "\n");
   }
-  const CaseFile parsed = parse_case_text(case_.dump(), kSessionFile, folder_);
-  model_ = load_model(parsed);
+  case_file_ = std::make_unique<CaseFile>(parse_case_text(case_.dump(), kSessionFile, folder_));
+  model_ = load_model(*case_file_);
   history_ = EditHistory(design_from_case(case_, kSessionFile, 1));
   journal_ = std::make_unique<SessionJournal>(journal_file);
   for (const nlohmann::json& entry : journal_->entries())

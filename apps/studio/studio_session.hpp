@@ -16,14 +16,24 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "cleave/io/case_file.hpp"
 #include "cleave/model/tissue_model.hpp"
 #include "studio/edit_history.hpp"
 #include "studio/session_journal.hpp"
 
 namespace cleave::studio {
 
+/// The case a new session starts from on a bare model (a model name or file, no case file):
+/// `model` is the case's "model" section. On the built-in abdomen the case also holds the demo's
+/// design settings and supports (pipeline/demo_case.hpp, abdomen_demo_settings: no equilibrium
+/// term, exact equilibration, the wall's rim and inner surface held), so the studio's preview
+/// opens as `cleave demo` does; it builds the model to place the rim. Other models: the model only
+/// (the library's defaults). InputError for a model that cannot be loaded.
+nlohmann::json bare_model_case(const nlohmann::json& model);
+
 /// The case a session starts from when neither the folder nor the command line names one: the
-/// built-in abdomen at half the paper's resolution (63 x 21 x 42 cells, paper table 1).
+/// built-in abdomen at half the paper's resolution (63 x 21 x 42 cells, paper table 1), with the
+/// demo's settings (bare_model_case).
 nlohmann::json default_session_case();
 
 class StudioSession {
@@ -37,6 +47,8 @@ class StudioSession {
   const std::filesystem::path& folder() const { return folder_; }
   const TissueModel& model() const { return *model_; }
   const nlohmann::json& case_document() const { return case_; }
+  /// The same parsed (model source resolved against the session folder).
+  const CaseFile& case_file() const { return *case_file_; }
   const DesignState& design() const { return history_.current(); }
   const EditHistory& history() const { return history_; }
   /// Number of acknowledged edits in this session (the journal's last seq).
@@ -63,6 +75,7 @@ class StudioSession {
 
   std::filesystem::path folder_;
   nlohmann::json case_;
+  std::unique_ptr<CaseFile> case_file_;
   std::unique_ptr<TissueModel> model_;
   EditHistory history_;
   std::unique_ptr<SessionJournal> journal_;

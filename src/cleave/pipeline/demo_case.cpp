@@ -63,20 +63,32 @@ json abdomen_demo_case(const TissueModel& model, DemoStress stress) {
   flap["path_mm"] = json::array({skin_point(model, 0.45 * w, 0.12 * l), skin_point(model, 0.45 * w, 0.27 * l),
                                  skin_point(model, 0.55 * w, 0.27 * l), skin_point(model, 0.55 * w, 0.12 * l)});
   c["cuts"] = json::array({across, along, flap});
+  const json settings = abdomen_demo_settings(model);
+  c["simulation"] = settings["simulation"];
+  if (with_design) {
+    c["design"] = settings["design"];
+    c["design"]["strokes"] = strokes;
+    c["design"]["control_points"] = controls;
+  } else {
+    c["residual_stress"] = {{"uniform_kPa", json::array({kLangerKPa, 0.0, kCrossKPa, 0.0, 0.0, 0.0})}};
+  }
+  return c;
+}
+
+json abdomen_demo_settings(const TissueModel& model) {
+  const Vec3 extent = model.volume.grid().extent_mm();
+  const double w = extent.x(), l = extent.z();
   const auto box = [](double x0, double y0, double z0, double x1, double y1, double z1) {
     return json{{"box_mm", json::array({json::array({x0, y0, z0}), json::array({x1, y1, z1})})}};
   };
   const double top = extent.y() + 1;
-  c["simulation"] = {{"mode", "static"},
+  json s = json::object();
+  s["design"] = {{"weights", {{"equilibrium", 0.0}}}, {"equilibrate", true}, {"equilibrium_support", "simulation"}};
+  s["simulation"] = {{"mode", "static"},
                      {"fixed", json::array({box(-1, -1, -1, kRimMm, top, l + 1), box(w - kRimMm, -1, -1, w + 1, top, l + 1),
                                             box(-1, -1, -1, w + 1, top, kRimMm), box(-1, -1, l - kRimMm, w + 1, top, l + 1),
                                             {{"surface", "inner"}}})}};
-  if (with_design)
-    c["design"] = {{"strokes", strokes}, {"control_points", controls}, {"weights", {{"equilibrium", 0.0}}}, {"equilibrate", true},
-                   {"equilibrium_support", "simulation"}};
-  else
-    c["residual_stress"] = {{"uniform_kPa", json::array({kLangerKPa, 0.0, kCrossKPa, 0.0, 0.0, 0.0})}};
-  return c;
+  return s;
 }
 
 }  // namespace cleave

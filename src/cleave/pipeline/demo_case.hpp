@@ -5,8 +5,9 @@
 //               lock in shear and underestimate the openings, docs/VALIDATION.md)
 //   materials   E = 80 kPa, nu = 0.4 for skin, fat and muscle (paper section 7)
 //   design      three strokes running horizontally around the body (along x), four control
-//               points 20 kPa along / 10 kPa across; no equilibrium term and no equilibration:
-//               the wall's supports, not the wall alone, balance the tension
+//               points 20 kPa along / 10 kPa across; no equilibrium term (w_E = 0), exactly
+//               equilibrated at the vertices the simulation leaves free (the held rim and inner
+//               surface carry the reactions: docs/stress-design.md)
 //   incisions   radius 8 mm, 5 mm deep (skin and fat), plugs removed, Poisson-disk spaced 35 mm
 //               over the upper part of the body (z from 0.55 to 0.9 of its length)
 //   cuts        a 5 cm scalpel cut across the lines (path along z) and one along them, 8 mm deep,
@@ -29,5 +30,12 @@ inline constexpr double kDemoCellSizeMm = 3.6;
 /// The demo case on `model` (the built-in abdomen at kDemoCellSizeMm); its paths and points are
 /// placed on that model's skin.
 nlohmann::json abdomen_demo_case(const TissueModel& model, DemoStress stress);
+
+/// The demo's design settings and supports on `model` (the built-in abdomen at any resolution),
+/// as case sections: {"design": {"weights": {"equilibrium": 0}, "equilibrate": true,
+/// "equilibrium_support": "simulation"}, "simulation": {"mode": "static", "fixed": [the 5 mm rim
+/// along the wall's four edges, {"surface": "inner"}]}}. The design section holds no strokes or
+/// control points. abdomen_demo_case uses them; so does the studio on the bare abdomen.
+nlohmann::json abdomen_demo_settings(const TissueModel& model);
 
 }  // namespace cleave

@@ -1,0 +1,122 @@
+// The studio's computation on the bare abdomen starts from the demo's settings (no equilibrium
+// term, exact equilibration at the free vertices, rim and inner surface held), so the preview's
+// round incisions open as in `cleave demo` (docs/stress-design.md: mean axis ratio 1.10, long axes
+// along Langer's lines) also away from the control points; a case file keeps its own settings.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <fstream>
+#include <mutex>
+#include <unistd.h>
+
+#include "cleave/pipeline/demo_case.hpp"
+#include "studio/finite_message.hpp"
+#include "studio/studio_compute.hpp"
+#include "studio/studio_main.hpp"
+#include "studio/studio_session.hpp"
+
+namespace cleave::studio {
+namespace {
+
+using nlohmann::json;
+
+std::filesystem::path fresh_folder(const std::string& name) {
+  const auto dir = std::filesystem::temp_directory_path() / ("cleave-compute-test-" + name + "-" + std::to_string(::getpid()));
+  std::filesystem::remove_all(dir);
+  return dir;
+}
+
+const json kCoarseAbdomen = {{"source", "abdomen"}, {"resolution", {48, 16, 32}}};
+
+TEST(StudioCase, TheBareAbdomenGetsTheDemosSettingsFromTheSharedFunction) {
+  const json c = bare_model_case(kCoarseAbdomen);
+  StudioSession s(fresh_folder("bare"), c);
+  const json demo = abdomen_demo_settings(s.model());
+  EXPECT_EQ(c["design"], demo["design"]);
+  EXPECT_EQ(c["simulation"], demo["simulation"]);
+  EXPECT_EQ(c["design"]["weights"]["equilibrium"], 0.0);
+  EXPECT_EQ(c["design"]["equilibrate"], true);
+  EXPECT_EQ(c["design"]["equilibrium_support"], "simulation");
+  EXPECT_EQ(bare_model_case({{"source", "plate"}, {"resolution", {8, 8, 2}}}),
+            json({{"cleave_case", 1}, {"model", {{"source", "plate"}, {"resolution", {8, 8, 2}}}}}))
+      << "other built-in models: the library's defaults";
+}
+
+TEST(StudioCase, ACaseFileKeepsItsOwnSettings) {
+  const auto folder = fresh_folder("own");
+  std::filesystem::create_directories(folder);
+  const json own = {{"cleave_case", 1},
+                    {"model", kCoarseAbdomen},
+                    {"design", {{"strokes", json::array()}, {"control_points", {{{"position", {0, 0, 0}}, {"langer_kPa", 5}, {"cross_kPa", 1}}}},
+                                {"weights", {{"equilibrium", 2.0}}}, {"equilibrate", false}}}};
+  std::ofstream(folder / "own.json") << own.dump();
+  const json c = *case_for_model_argument((folder / "own.json").string(), "");
+  EXPECT_EQ(c["design"]["weights"]["equilibrium"], 2.0);
+  EXPECT_EQ(c["design"]["equilibrate"], false);
+  EXPECT_FALSE(c.contains("simulation"));
+  const json bare = *case_for_model_argument("abdomen", "48x16x32");
+  EXPECT_EQ(bare["design"]["equilibrium_support"], "simulation");
+}
+
+TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
+  StudioSession session(fresh_folder("preview"), bare_model_case(kCoarseAbdomen));
+  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
+  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
+  for (const json& p : demo["control_points"])
+    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
+                        {"cross_kPa", p["cross_kPa"]}});
+  std::mutex m;
+  std::vector<json> sent;
+  StudioCompute compute(session, [&](std::string text) {
+    std::lock_guard lock(m);
+    sent.push_back(json::parse(text));
+  });
+  compute.design_changed(session.design(), session.seq());
+  compute.wait_idle();
+  std::lock_guard lock(m);
+  ASSERT_FALSE(sent.empty());
+  for (const json& message : sent) {
+    EXPECT_NE(message["type"], "error") << message.dump().substr(0, 300);
+    EXPECT_EQ(first_non_finite(message), std::nullopt);
+  }
+  const json& r = sent.back();
+  ASSERT_EQ(r["type"], "result");
+  EXPECT_FALSE(r.contains("design_error")) << r.dump().substr(0, 300);
+  EXPECT_LT(r["equilibrium_residual"]["final"].get<double>(), 1e-8) << "exactly equilibrated at the free vertices";
+  EXPECT_TRUE(r["timings_ms"].contains("equilibration"));
+
+  // Control points at 0.3 and 0.7 of the width and length; incisions farther than 40 mm from all
+  // of them must open too (with the least-squares equilibrium term they closed there).
+  std::vector<Vec3> points;
+  for (const json& p : demo["control_points"]) points.push_back(Vec3(p["position"][0], p["position"][1], p["position"][2]));
+  const json& incisions = r["incisions"];
+  ASSERT_GE(incisions.size(), 8u);
+  int far = 0, far_open = 0, along = 0;
+  double ratio_sum = 0;
+  for (const json& i : incisions) {
+    const Vec3 c(i["centre_mm"][0], i["centre_mm"][1], i["centre_mm"][2]);
+    double nearest = 1e9;
+    for (const Vec3& p : points) nearest = std::min(nearest, (c - p).norm());
+    const double opening = i["opening_mm"];
+    const double ratio = i["axis_ratio"];
+    EXPECT_GT(opening, 0.0) << "every margin opens (the skin is in tension)";
+    EXPECT_LT(opening, 5.0) << "an 8 to 17 mm incision does not gape by centimetres";
+    EXPECT_GE(ratio, 1.0);
+    EXPECT_LT(ratio, 1.3);
+    ratio_sum += ratio;
+    if (i.contains("langer_angle_deg") && i["langer_angle_deg"].get<double>() < 20) ++along;
+    if (nearest > 40) {
+      ++far;
+      if (opening > 0.3) ++far_open;
+    }
+  }
+  const double mean_ratio = ratio_sum / static_cast<double>(incisions.size());
+  EXPECT_GT(mean_ratio, 1.03) << "round incisions open into ellipses (demo: 1.10)";
+  EXPECT_LT(mean_ratio, 1.2);
+  EXPECT_GE(far, 3);
+  EXPECT_EQ(far_open, far) << "incisions away from the control points open by more than 0.3 mm";
+  EXPECT_GE(along, static_cast<int>(incisions.size()) * 3 / 4) << "long axes along Langer's lines";
+}
+
+}  // namespace
+}  // namespace cleave::studio
