@@ -17,6 +17,13 @@ namespace {
 constexpr double kPaperCgTolerance = 1e-12;    ///< relative residual of the reference CG
 constexpr int kPaperCgMaxIterations = 200000;  ///< the plain CG needs many iterations on A^T A
 
+bool same_frames(const std::vector<DirectionFrame>& a, const std::vector<DirectionFrame>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t c = 0; c < a.size(); ++c)
+    if (a[c].langer != b[c].langer || a[c].cross != b[c].cross || a[c].normal != b[c].normal) return false;
+  return true;
+}
+
 }  // namespace
 
 EigenvalueInterpolator::EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights,
@@ -105,15 +112,17 @@ EigenvalueSolution EigenvalueInterpolator::solve_coupled(const std::vector<Direc
   std::vector<CellId> constrained;
   for (const EigenvalueTarget& t : targets) constrained.push_back(t.cell);
   const std::vector<bool> pinned = cells_of_unconstrained_pieces(volume_, constrained);
-  Eigen::SparseMatrix<double> system = smoothness_;
-  if (weights_.equilibrium > 0.0) {
+  if (weights_.equilibrium > 0.0 && !(frames_of_equilibrium_ && same_frames(frames, *frames_of_equilibrium_))) {
+    // The eq. 6 rows depend on the frames only: kept while they stay (control point edits).
     const double h = volume_.grid().cell_size_mm;
     SparseMatrix g_rows = eigenvalue_divergence_matrix(volume_, frames);
     drop_held_vertex_rows(g_rows, held_vertices_);
     const Eigen::SparseMatrix<double> g = g_rows;
     const Eigen::SparseMatrix<double> gtg = Eigen::SparseMatrix<double>(g.transpose()) * g;
-    system += (weights_.equilibrium / (h * h * h * h)) * gtg;
+    smoothness_and_equilibrium_ = smoothness_ + (weights_.equilibrium / (h * h * h * h)) * gtg;
+    frames_of_equilibrium_ = frames;
   }
+  Eigen::SparseMatrix<double> system = weights_.equilibrium > 0.0 ? smoothness_and_equilibrium_ : smoothness_;
   Vector rhs = Vector::Zero(n);
   for (const EigenvalueTarget& t : targets) {
     for (int i = 0; i < 3; ++i) {

@@ -23,6 +23,7 @@
 // preconditioner), started from `warm_start` when it has the right size, to relative residual
 // 1e-12; ComputeError when it does not get there.
 // Never returns a non-finite eigenvalue: ComputeError "eigenvalue interpolation: ..." instead.
+#include <optional>
 #include <vector>
 
 #include "cleave/grid/linked_volume.hpp"
@@ -63,6 +64,9 @@ class EigenvalueInterpolator {
   std::vector<VertexId> held_vertices_;
   Eigen::SparseMatrix<double> smoothness_;         ///< w_L (L^T L) (x) I3, ColMajor
   Eigen::SparseMatrix<double> scalar_smoothness_;  ///< w_L L^T L, ColMajor (w_E = 0)
+  /// w_E > 0: smoothness_ + w_E G^T G / h^4 for the frames it was built with (kept across control point edits)
+  Eigen::SparseMatrix<double> smoothness_and_equilibrium_;
+  std::optional<std::vector<DirectionFrame>> frames_of_equilibrium_;
   SparseCholesky cholesky_;
   int factorizations_ = 0;
 };
