@@ -19,6 +19,7 @@ if(CLEAVE_NODE AND TARGET cleave_cli)
   add_test(NAME browser_e2e
            COMMAND ${CLEAVE_NODE} --experimental-websocket --test --test-concurrency=1
                    ${CMAKE_CURRENT_SOURCE_DIR}/browser/server.test.mjs ${CMAKE_CURRENT_SOURCE_DIR}/browser/studio.test.mjs
+                   ${CMAKE_CURRENT_SOURCE_DIR}/browser/interactions.test.mjs
            WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
   set_tests_properties(browser_e2e PROPERTIES
     LABELS "browser"

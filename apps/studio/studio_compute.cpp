@@ -147,6 +147,10 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
     : session_(session), send_(std::move(send)) {
   worker_ = std::make_unique<FieldWorker>(
       [this](FieldWorker::Result r) {
+        // How much work the edits caused: a burst of edits starts fewer computations than edits
+        // (the worker drops stale ones), which the page and its tests can see.
+        if (r.message.value("type", "") == "result")
+          r.message["computations"] = {{"started", worker_->jobs_started()}, {"published", ++results_published_}};
         std::string text = r.message.dump();
         {
           std::lock_guard lock(latest_mutex_);

@@ -84,6 +84,7 @@ class StudioCompute {
     std::vector<Vec6> stress_kPa;              ///< per cell; empty = none designed
     SurfaceMesh mesh;                          ///< deformed render surface
   };
+  std::uint64_t results_published_ = 0;  ///< worker thread
   mutable std::mutex latest_mutex_;
   std::string latest_result_;
   ExportSnapshot latest_export_;

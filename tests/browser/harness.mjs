@@ -81,10 +81,14 @@ export async function launchBrowser(chromiumPath) {
 export async function openStudio(context, url) {
   const page = await context.newPage();
   const errors = [];
+  const consoleErrors = [];
   page.on('pageerror', (e) => errors.push(e.message));
+  // Console errors of the page itself (WebGL, three.js); the browser's missing-favicon 404 is not one.
+  page.on('console', (m) => { if (m.type() === 'error' && !/favicon/.test(m.location().url || '')) consoleErrors.push(m.text()); });
   await page.goto(url);
   await page.waitForFunction(() => window.studio && window.studio.app.result && window.studio.app.state, null, { timeout: 60000 });
   page.jsErrors = errors;
+  page.consoleErrors = consoleErrors;
   return page;
 }
 
@@ -116,6 +120,28 @@ export async function surfacePath(page, lengthPx = 160, steps = 16) {
     if (ok) return pts;
   }
   throw new Error('no horizontal path across the body near the canvas centre');
+}
+
+/// The fraction of surface vertices within `radius` mm of `centre` whose direction is within
+/// 25 degrees of `tangent` (undirected), and how many there are.
+export function alignedNear(result, centre, tangent, radius) {
+  const p = result.surface.positions_mm, dir = result.fields.direction;
+  const t = unit(tangent);
+  let near = 0, aligned = 0;
+  for (let i = 0; i < p.length / 3; i++) {
+    if (Math.hypot(p[3 * i] - centre[0], p[3 * i + 1] - centre[1], p[3 * i + 2] - centre[2]) > radius) continue;
+    near++;
+    const v = unit([dir[3 * i], dir[3 * i + 1], dir[3 * i + 2]]);
+    if (Math.abs(v[0] * t[0] + v[1] * t[1] + v[2] * t[2]) > 0.9) aligned++;
+  }
+  return { near, fraction: near ? aligned / near : 0 };
+}
+
+export const unit = (v) => { const n = Math.hypot(...v); return v.map((x) => x / n); };
+
+/// Canvas points (x, y) that all hit the body, or null.
+export async function onBody(page, pts) {
+  return (await page.evaluate((p) => p.every(([x, y]) => window.studio.pickAt(x, y) !== null), pts)) ? pts : null;
 }
 
 export async function mouseDrag(page, pts) {

@@ -15,6 +15,9 @@ const app = {
   wound: null,
   lastError: null,
   frames: 0,
+  resultSeqs: [],       // the edit (seq) of every result received, in order
+  progressCount: 0,     // progress messages seen (work longer than 0.25 s)
+  lastProgress: null,
 };
 window.studio = { app, viewer, pickAt: (x, y) => viewer.pick(x, y), screenOf: (p) => viewer.screenOf(p) };
 
@@ -31,11 +34,19 @@ function onMessage(m) {
   } else if (m.type === 'result') {
     app.result = m;
     app.resultCount++;
+    app.resultSeqs.push(m.seq);
     viewer.setResult(m);
     refreshDesign();
     showTimings(m.timings_ms || {});
     showNotes(m);
     $('progress').hidden = true;
+    showPreview(m.incisions || []);
+    if (m.flaps && m.flaps.length) {
+      const f = m.flaps[m.flaps.length - 1];
+      $('flap-change').textContent = `${f.skin_area_change_percent.toFixed(1)} % of ${f.skin_area_mm2.toFixed(0)} mm² (volume ${f.volume_change_percent.toFixed(1)} %)`;
+    } else {
+      $('flap-change').textContent = '–';
+    }
     if (m.wounds && m.wounds.length) {
       app.wound = m.wounds[m.wounds.length - 1];
       $('wound-width').textContent = `${app.wound.width_mm.toFixed(1)} mm (max), ${app.wound.mean_width_mm.toFixed(2)} mm (mean)`;
@@ -55,15 +66,19 @@ function onMessage(m) {
     $('progress').querySelector('.fill').style.width = `${((100 * m.index) / m.frames).toFixed(0)}%`;
     $('progress').querySelector('.text').textContent = `opening the wound: frame ${m.index}/${m.frames} · ${m.step_ms.toFixed(0)} ms per step`;
   } else if (m.type === 'progress') {
+    app.progressCount++;
+    app.lastProgress = m;
     $('progress').hidden = false;
     $('progress').querySelector('.fill').style.width = `${(100 * m.fraction).toFixed(0)}%`;
     $('progress').querySelector('.text').textContent = `${m.stage}…`;
   } else if (m.type === 'error') {
+    // A computation that failed (e.g. a non-finite value, naming its stage) keeps the last picture.
+    if (m.stage) $('progress').hidden = true;
     setMessage(m.message, true);
   }
 }
 
-const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', cuts: 'cut model', opening: 'wound opening (frames)',
+const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', equilibration: 'equilibration', cuts: 'cut model', opening: 'wound opening (frames)',
   frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', total: 'edit to picture' };
 function showTimings(t) {
   const rows = Object.keys(STAGES).filter((k) => t[k] !== undefined).map((k) => {
@@ -74,6 +89,15 @@ function showTimings(t) {
   $('timing-table').replaceChildren(...rows);
   $('timing-total').textContent = t.total !== undefined ? `${t.total.toFixed(0)} ms` : '–';
   $('timings').textContent = Object.entries(t).map(([k, v]) => `${k} ${v.toFixed(0)} ms`).join(' · ');
+}
+
+/// The round-incision preview in numbers: how far the margins open and how elliptic they become.
+function showPreview(incisions) {
+  $('incision-count').textContent = incisions.length;
+  if (!incisions.length) { $('preview-info').textContent = '–'; return; }
+  const mean = (key) => incisions.reduce((a, i) => a + i[key], 0) / incisions.length;
+  const min = Math.min(...incisions.map((i) => i.opening_mm)), max = Math.max(...incisions.map((i) => i.opening_mm));
+  $('preview-info').textContent = `opening ${min.toFixed(2)} to ${max.toFixed(2)} mm (mean ${mean('opening_mm').toFixed(2)} mm) · axis ratio ${mean('axis_ratio').toFixed(3)}`;
 }
 
 /// What the last result could not compute, shown in the page (the rest of the result still is).
@@ -179,7 +203,7 @@ function setTool(tool) {
     orbit: 'drag: orbit · right-drag: pan · wheel: zoom',
     stroke: 'press and drag on the surface to draw a Langer stroke · drag a stroke with Shift to move it',
     magnitude: 'click on the surface to place a control point · drag an arrow tip to change its eigenvalue',
-    cut: 'press and drag on the surface to cut · choose scalpel or flap and the depth on the right',
+    cut: 'press and drag on the surface to cut · a flap: drag from its hinge to its tip (width and depth on the right)',
   }[tool];
 }
 for (const b of document.querySelectorAll('button.tool')) b.onclick = () => setTool(b.dataset.tool);
@@ -188,6 +212,30 @@ setTool('orbit');
 const canvas = $('canvas');
 let drag = null;
 const local = (e) => { const r = canvas.getBoundingClientRect(); return [e.clientX - r.left, e.clientY - r.top]; };
+
+/// A U-shaped flap of the panel's width around the drawn line (its hinge at the start, its tip at
+/// the end): [hinge left, tip left, tip right, hinge right], each corner put back on the surface
+/// under it. Null for a line too short to give a direction.
+function flapOutline(points, width) {
+  const a = new THREE.Vector3(...points[0]), b = new THREE.Vector3(...points[points.length - 1]);
+  const along = b.clone().sub(a);
+  if (along.length() < 1e-3 || !(width > 0)) return null;
+  const n = new THREE.Vector3(...frameAt(a.clone().add(b).multiplyScalar(0.5).toArray()).normal);
+  const side = n.clone().cross(along).normalize().multiplyScalar(0.5 * width);
+  if (!Number.isFinite(side.x)) return null;
+  return [a.clone().add(side), b.clone().add(side), b.clone().sub(side), a.clone().sub(side)].map((p) => {
+    const [x, y] = viewer.screenOf(p.toArray());
+    const hit = viewer.pick(x, y);
+    return hit ? hit.point.toArray() : p.toArray();
+  });
+}
+
+/// The path sent for the drawn points: a scalpel follows the pointer; a flap is the U around it.
+function cutPath(points) {
+  if ($('cut-kind').value !== 'flap') return points;
+  return flapOutline(points, Number($('flap-width').value));
+}
+window.studio.flapOutline = flapOutline;
 
 function nearestStroke(point) {
   let best = null, bestD = Infinity;
@@ -257,7 +305,7 @@ canvas.addEventListener('pointermove', (e) => {
   if (Math.hypot(hit.point.x - last[0], hit.point.y - last[1], hit.point.z - last[2]) >= spacing) {
     drag.points.push(hit.point.toArray());
     viewer.setDesign({ ...app.state.design, strokes: [...app.state.design.strokes, ...(drag.kind === 'stroke' ? [{ id: -1, points_mm: drag.points.length > 1 ? drag.points : [last, last] }] : [])],
-      cuts: [...app.state.design.cuts, ...(drag.kind === 'cut' && drag.points.length > 1 ? [{ id: -1, kind: $('cut-kind').value, path_mm: drag.points }] : [])] },
+      cuts: [...app.state.design.cuts, ...(drag.kind === 'cut' && drag.points.length > 1 ? [{ id: -1, kind: $('cut-kind').value, path_mm: cutPath(drag.points) || drag.points }] : [])] },
       app.selected.id, (p) => frameAt(p.position_mm));
   }
 });
@@ -276,7 +324,11 @@ canvas.addEventListener('pointerup', () => {
   }
   if (d.points.length < 2) { refreshDesign(); return; }
   if (d.kind === 'stroke') send('add_stroke', { points_mm: d.points }).catch(() => {});
-  if (d.kind === 'cut') send('add_cut', { kind: $('cut-kind').value, path_mm: d.points, depth_mm: Number($('cut-depth').value) }).catch(() => {});
+  if (d.kind === 'cut') {
+    const path = cutPath(d.points);
+    if (!path) { refreshDesign(); return; }
+    send('add_cut', { kind: $('cut-kind').value, path_mm: path, depth_mm: Number($('cut-depth').value) }).catch(() => {});
+  }
 });
 
 // --- panel and toolbar ------------------------------------------------------------------------
@@ -292,6 +344,7 @@ $('redo').onclick = () => send('redo').catch(() => {});
 $('reset-view').onclick = () => viewer.resetView();
 $('reset-cuts').onclick = () => send('reset_cuts').catch(() => {});
 $('display').onchange = () => viewer.setDisplay($('display').value);
+$('cut-kind').onchange = () => { $('flap-width-label').hidden = $('cut-kind').value !== 'flap'; };
 $('save').onclick = () => send('save', { file: $('file-name').value }).then(() => { $('files-note').innerHTML = `saved <a href="/session/${encodeURIComponent($('file-name').value)}">${$('file-name').value}</a>`; }).catch(() => {});
 $('load').onclick = () => send('load', { file: $('file-name').value }).catch(() => {});
 $('export').onchange = () => {
