@@ -4,6 +4,7 @@
 #include "cleave/stress/sparse_cholesky.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <limits>
@@ -18,8 +19,7 @@ using Clock = std::chrono::steady_clock;
 
 double seconds_between(Clock::time_point a, Clock::time_point b) { return std::chrono::duration<double>(b - a).count(); }
 
-/// CG with the kept factor projects its remaining work only from this iteration on (a low-rank
-/// edit of rank k converges in about k + 1 iterations, with a residual that need not fall before).
+/// CG with the kept factor projects its remaining work from this iteration on at the earliest.
 constexpr int kFirstProjectedIteration = 4;
 
 }  // namespace
@@ -97,6 +97,21 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
   // Giving up costs a factorization and a refined solve of every column.
   const double refactor_seconds =
       impl_->factor_seconds + static_cast<double>(b.cols()) * (kRefinementSteps + 1) * impl_->solve_seconds;
+  // A change of d diagonal entries only (constraints added or removed) is a rank-d update: CG with
+  // the old factor converges in about d + 1 iterations per column, with a residual that need not
+  // fall before. Refactorize at once when those iterations cost more than a new factor.
+  int changed = 0;
+  bool diagonal_only = true;
+  for (Eigen::Index j = 0; j < a.outerSize(); ++j)
+    for (int k = a.outerIndexPtr()[j]; k < a.outerIndexPtr()[j + 1]; ++k)
+      if (a.valuePtr()[k] != impl_->values[static_cast<std::size_t>(k)]) {
+        ++changed;
+        diagonal_only = diagonal_only && a.innerIndexPtr()[k] == j;
+      }
+  Eigen::Index columns = 0;
+  for (Eigen::Index col = 0; col < b.cols(); ++col) columns += b.col(col).squaredNorm() > 0.0 ? 1 : 0;
+  if (diagonal_only && static_cast<double>(columns) * (changed + 1) * impl_->solve_seconds > refactor_seconds) return false;
+  const int first_projected_iteration = diagonal_only ? std::max(kFirstProjectedIteration, changed + 2) : kFirstProjectedIteration;
   const Clock::time_point start = Clock::now();
   for (Eigen::Index col = 0; col < b.cols(); ++col) {
     const double b_norm = b.col(col).norm();
@@ -123,7 +138,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       const double r_norm = r.norm();
       converged = r_norm <= relative_tolerance * b_norm;
       if (converged) break;
-      if (it + 1 >= kFirstProjectedIteration) {
+      if (it + 1 >= first_projected_iteration) {
         // Off track (a stroke edit of a line field changes hundreds of rows: CG stalls near 1e-5),
         // or on track but dearer than a new factor (the coupled system after a frame change):
         // give up so that the caller's factorization is not preceded by wasted solves.

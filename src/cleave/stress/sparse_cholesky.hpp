@@ -33,10 +33,12 @@ class SparseCholesky {
   /// design edit changed some values) it runs conjugate gradients preconditioned with the kept
   /// factor, column by column: an edit that changes a few constraint rows is a low-rank change, so
   /// CG needs about as many iterations as the rank of the change and no new factorization is
-  /// needed. CG gives up as soon as it is cheaper to factorize: from its 4th iteration on it
+  /// needed. It gives up as soon as it is cheaper to factorize: when only d diagonal entries
+  /// changed (constraints added, moved or removed: a rank-d update, about d + 1 iterations) and
+  /// d + 1 solves per column cost more than the last factorization plus a refined solve, it does
+  /// not start; otherwise, from its 4th iteration on (its (d + 2)th for a diagonal change), it
   /// projects its remaining iterations from the residual's mean rate and stops when their
-  /// measured cost exceeds that of the last factorization plus a refined solve, or when they
-  /// would exceed max_iterations. Returns true when every column reached
+  /// measured cost exceeds that of a new factor, or when they would exceed max_iterations. Returns true when every column reached
   /// ||b - a x|| <= relative_tolerance ||b||; false (x unspecified) when there is no factor, the
   /// pattern differs, or CG gave up: then factorize(a).
   bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
