@@ -63,6 +63,14 @@ TEST(FuzzRegressions, NiftiDimensionCountOutOfRange) {
             file.string() + ": header dim[0] is 4294967299; expected 1 to 7 dimensions");
 }
 
+// fuzz_nifti (2 h campaign): a 348-byte NIfTI-1 header declaring 5.7 GB of samples made
+// nifti_image_load allocate them all before finding the data missing.
+TEST(FuzzRegressions, NiftiDeclaringMoreSamplesThanTheFileHoldsIsRefusedBeforeAllocating) {
+  const auto file = kRegressions / "nifti" / "header_declares_5_7_GB.nii";
+  const std::string error = error_of([&] { (void)read_nifti_volume(file); });
+  EXPECT_EQ(error.rfind(file.string() + ": the image data is truncated or unreadable (expected ", 0), 0u) << error;
+}
+
 // fuzz_nrrd: bytes without the NRRD magic went to teem's other readers (plain text here), which
 // leak on their error paths.
 TEST(FuzzRegressions, NrrdWithoutMagicIsRefusedBeforeTeem) {

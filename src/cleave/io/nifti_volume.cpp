@@ -1,7 +1,10 @@
 #include "cleave/io/nifti_volume.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <cstdint>
 #include <cstdlib>
+#include <filesystem>
 #include <fmt/format.h>
 #include <limits>
 #include <memory>
@@ -85,6 +88,19 @@ bool is_scalar_type(int datatype) {
   }
 }
 
+/// The most sample bytes the image's data file can hold: its size past the data offset, or for a
+/// gzip-compressed file 1032 times its size (the largest ratio deflate reaches).
+std::uint64_t readable_sample_bytes(const nifti_image& nim, const std::string& header_file) {
+  const std::string data_file = nim.iname != nullptr ? nim.iname : header_file;
+  std::error_code ec;
+  const std::uintmax_t size = std::filesystem::file_size(data_file, ec);
+  if (ec) return 0;
+  constexpr std::uint64_t kDeflateMaxRatio = 1032;
+  if (nifti_is_gzfile(data_file.c_str()) != 0) return kDeflateMaxRatio * static_cast<std::uint64_t>(size);
+  const auto offset = static_cast<std::uint64_t>(std::max<std::int64_t>(nim.iname_offset, 0));
+  return size > offset ? static_cast<std::uint64_t>(size) - offset : 0;
+}
+
 }  // namespace
 
 ImageVolume read_nifti_volume(const std::filesystem::path& file) {
@@ -143,6 +159,12 @@ ImageVolume read_nifti_volume(const std::filesystem::path& file) {
   }
   image.integer_samples = nim->datatype != DT_FLOAT32 && nim->datatype != DT_FLOAT64;
 
+  // Before nifticlib allocates the declared samples: a file cannot hold more than its size (past
+  // the data offset), or, gzip-compressed, more than deflate's largest ratio (1032:1) of its size.
+  // A 348-byte header declaring 5.7 GB of samples made nifti_image_load allocate them (fuzz_nifti).
+  const std::uint64_t data_bytes = samples * static_cast<std::uint64_t>(nim->nbyper);
+  if (data_bytes > readable_sample_bytes(*nim, f))
+    throw InputError(fmt::format("{}: the image data is truncated or unreadable (expected {} bytes of samples)", f, data_bytes));
   if (nifti_image_load(nim.get()) != 0 || nim->data == nullptr)
     throw InputError(fmt::format("{}: the image data is truncated or unreadable (expected {} bytes of samples)", f,
                                  samples * static_cast<std::uint64_t>(nim->nbyper)));
