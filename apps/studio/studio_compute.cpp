@@ -179,8 +179,7 @@ void StudioCompute::prepare(const FieldWorker::Context& ctx) {
   const TissueModel& model = session_.model();
   design_settings_ = design_settings(session_.case_file());
   simulation_ = parse_simulation_settings(session_.case_file());
-  held_uncut_ = held_vertices(model, simulation_);
-  if (design_settings_.support == EquilibriumSupport::simulation) design_settings_.held_vertices = held_uncut_;
+  if (design_settings_.support == EquilibriumSupport::simulation) design_settings_.held_vertices = held_vertices(model, simulation_);
   body_surface_ = std::make_unique<BodySurface>(model);
   const double h = model.volume.grid().cell_size_mm;
   IncisionPattern pattern;

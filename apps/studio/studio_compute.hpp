@@ -53,11 +53,11 @@ class StudioCompute {
 
   // Worker-thread state (only the worker touches these).
   /// The session case's design settings (weights, equilibration, support; no strokes or points)
-  /// and supports ("simulation"/"fixed"), read once.
+  /// and supports ("simulation"/"fixed"), read once; with the "simulation" support the design's
+  /// held_vertices are those of the uncut model.
   StressDesign design_settings_;
   SimulationSettings simulation_;
-  std::vector<VertexId> held_uncut_;                  ///< held vertices of the uncut model
-  std::vector<VertexId> held_cut_;                    ///< the same on preview_model_
+  std::vector<VertexId> held_cut_;                    ///< held vertices of preview_model_
   std::unique_ptr<BodySurface> body_surface_;         ///< of the uncut model
   std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
   std::unique_ptr<StressDesigner> designer_;
