@@ -1,6 +1,7 @@
 // The render surface: closed and oriented, genus, enclosed volume, cuts open it, embedding.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 
@@ -137,6 +138,44 @@ TEST(RenderSurface, NonManifoldRingAroundACornerStaysClosed) {
   const SurfaceTopology t = topology_of(s);
   EXPECT_TRUE(t.closed_and_oriented());
   EXPECT_EQ(t.components, 1);
+}
+
+/// All voxels of a dims box except `missing`.
+std::vector<Vec3i> box_voxels(const Vec3i& dims, const std::vector<Vec3i>& missing = {}) {
+  std::vector<Vec3i> voxels;
+  for (int z = 0; z < dims.z(); ++z)
+    for (int y = 0; y < dims.y(); ++y)
+      for (int x = 0; x < dims.x(); ++x)
+        if (std::find(missing.begin(), missing.end(), Vec3i(x, y, z)) == missing.end()) voxels.push_back({x, y, z});
+  return voxels;
+}
+
+TEST(RenderSurface, OneCellSlitFromTheOutsideIsClosedWhereItMeetsTheOutside) {
+  // One cut face of a 2x2x3 box whose lower edge lies on the box's -y side and whose other three
+  // edges are crack fronts (the demo's defect, reduced). Both ends of the edge on the outside are
+  // unsplit linked-volume vertices, so material pairing used that surface edge twice on each side
+  // of the cut (4 triangles). The simulation mesh holds both lips of the slit together there, and
+  // so does the surface now: the outside passes over the slit, whose two faces close into a crack
+  // inside the body.
+  TissueModel model = mask_model({2, 2, 3}, box_voxels({2, 2, 3}));
+  model.volume.cut_links(std::vector<CellFace>{{model.volume.cell_at_voxel({0, 0, 1}), 1}});
+  const SurfaceTopology t = topology_of(build_render_surface(model));
+  EXPECT_TRUE(t.closed_and_oriented()) << t.non_manifold_edges << " non-manifold, " << t.misoriented_edges
+                                       << " misoriented";
+  EXPECT_EQ(t.components, 2);  // the box's outside and the closed slit
+  EXPECT_EQ(t.euler_characteristic(), 4);
+}
+
+TEST(RenderSurface, CellsTouchingAlongAnEdgeAndJoinedAtBothEndsShareThatEdge) {
+  // The middle layer of a 2x2x3 box keeps two diagonal cells only; they touch along the vertical
+  // centre edge and share the vertices at both its ends through the full layers above and below.
+  // The surface joins them along that edge as the simulation mesh does: one closed sphere.
+  const TissueModel model = mask_model({2, 2, 3}, box_voxels({2, 2, 3}, {{0, 0, 1}, {1, 1, 1}}));
+  const SurfaceTopology t = topology_of(build_render_surface(model));
+  EXPECT_TRUE(t.closed_and_oriented()) << t.non_manifold_edges << " non-manifold, " << t.misoriented_edges
+                                       << " misoriented";
+  EXPECT_EQ(t.components, 1);
+  EXPECT_EQ(t.euler_characteristic(), 2);
 }
 
 TEST(RenderSurface, MaskModelIsSmoothedButClosed) {

@@ -3,12 +3,24 @@
 // vertices (dual contouring on the linked volume).
 //
 // A boundary face is a cell face whose link is absent or cut. Around each of its two edges
-// through the corner, a boundary face is chained to the next boundary face met by walking from
-// its cell through linked cells around that edge. Following the chain around the corner gives
-// closed fans; each fan becomes one surface vertex. Because the walk only crosses linked faces,
-// all cells of a fan share one linked-volume vertex, and because every face has exactly one
-// successor across each edge, every surface edge is used by exactly two faces (also where cells
-// touch only along an edge or at a point: those become separate fans).
+// through the corner, a boundary face is chained to one other boundary face of that grid edge
+// (its partner), and following the chain around the corner gives closed fans; each fan becomes
+// one surface vertex. Every face has exactly one partner across each edge and both ends of a
+// grid edge use the same partners, so every surface edge is used by exactly two faces.
+//
+// Partners: around a grid edge, the runs of linked cells (sectors) are separated by cut or
+// absent links. Normally a face is joined to the face at the other end of its own sector, found
+// by walking from its cell through linked cells around the edge; cells that touch only along an
+// edge or at a point become separate fans, and all cells of a fan share one linked-volume vertex.
+// Where two or more sectors of one edge have the same linked-volume vertex at both ends of the
+// edge (a slit whose mouth is a single grid edge between two crack tips, on the body's outside
+// or on the wall of a hole left by a removed plug; two cells touching along an edge and joined
+// at both its ends), they are all in one fan at each end, and material partners would give two
+// surface edges between the same two vertices (4 triangles on one edge). Those sectors are
+// joined across the gaps between them instead, in ring order (the end of each with the start of
+// the next), as the simulation mesh holds them together along the edge; the fans at both ends
+// split so that each pair has its own surface edge, and a fan's cells still share one vertex.
+// Such a slit is closed at its mouth: a crack inside the body, a closed surface of its own.
 #include <array>
 #include <vector>
 

@@ -14,7 +14,9 @@
 //     faces are chained across each edge by walking through linked material, so every surface
 //     edge is used by exactly two triangles and every vertex is a single disk, also where cells
 //     touch only along an edge or at a point. All cells of a fan share one linked-volume vertex;
-//     a split linked-volume vertex always gives separate surface vertices.
+//     a split linked-volume vertex always gives separate surface vertices. Where the linked
+//     volume holds two runs of cells around a grid edge together at both its ends (a one-cell
+//     slit between two crack tips), the surface joins them along that edge too.
 //   - Positions (surface_vertex_placement.hpp): vertices on the body's outside move to the zero
 //     crossing of the corner signed distance (LabelVolume::corner_distance_mm) within their dual
 //     cell, or of a smoothed occupancy when the model is a voxel mask; vertices on a cut rim move
