@@ -1,9 +1,9 @@
 // Property test of the render surface under random cuts: on a small box (with a few voxels
 // missing, so that cells also touch along edges and at points), batches of random link cuts,
-// one-cell slits from a grid plane, isolated cells and crack tips. After every batch the
-// incrementally updated surface must equal a fresh build and be closed, manifold and
-// consistently oriented, with every vertex a single linked-volume vertex embedded in one of its
-// cells.
+// one-cell slits from a grid plane, crosses of slits around one grid edge, isolated cells and
+// crack tips. After every batch the incrementally updated surface must equal a fresh build and
+// be closed, manifold and consistently oriented, with every vertex a single linked-volume vertex
+// embedded in one of its cells.
 //
 // Components: every closed surface component bounds material of exactly one volume component,
 // and every volume component has at least one. The counts are not equal in general: a piece
@@ -88,10 +88,34 @@ std::vector<CellFace> isolated_cell(const LinkedVolume& volume, std::mt19937& rn
   return links;
 }
 
+/// The four links around one grid edge (a random edge of a random cell): a cross of one-cell
+/// slits, whose four runs of cells around the edge may share the vertices at both its ends.
+std::vector<CellFace> cross_around_edge(const LinkedVolume& volume, std::mt19937& rng) {
+  const CellId c = std::uniform_int_distribution<CellId>(0, volume.cell_count() - 1)(rng);
+  const int axis = std::uniform_int_distribution<int>(0, 2)(rng);
+  const int u = (axis + 1) % 3;
+  const int v = (axis + 2) % 3;
+  // The edge of cell c along `axis` at its +u, +v corner; the ring is c and its +u, +v, +u+v cells.
+  const Vec3i origin = volume.cell_voxel(c);
+  const Vec3i du = corner_offset(1 << u);
+  const Vec3i dv = corner_offset(1 << v);
+  std::vector<CellFace> links;
+  const auto link = [&](const Vec3i& voxel, int a) {
+    const CellId cell = volume.cell_at_voxel(voxel);
+    if (cell != kNone && volume.neighbor(cell, 2 * a + 1) != kNone) links.push_back({cell, 2 * a + 1});
+  };
+  link(origin, u);
+  link(origin, v);
+  link(origin + dv, u);
+  link(origin + du, v);
+  return links;
+}
+
 std::vector<CellFace> random_cut(const LinkedVolume& volume, std::mt19937& rng) {
-  switch (std::uniform_int_distribution<int>(0, 3)(rng)) {
+  switch (std::uniform_int_distribution<int>(0, 4)(rng)) {
     case 0: return random_slit(volume, rng);
     case 1: return isolated_cell(volume, rng);
+    case 4: return cross_around_edge(volume, rng);
     case 2: return random_links(volume, rng, 0.05);
     default: return random_links(volume, rng, 0.25);
   }

@@ -178,6 +178,21 @@ TEST(RenderSurface, CellsTouchingAlongAnEdgeAndJoinedAtBothEndsShareThatEdge) {
   EXPECT_EQ(t.euler_characteristic(), 2);
 }
 
+TEST(RenderSurface, CrossOfFourSlitsAroundAnInnerEdgeGivesFourClosedCracks) {
+  // The four links around the vertical centre edge of the middle layer of a 4x4x3 box: four
+  // one-cell slits meeting at the edge, all cells sharing the vertices at both its ends through
+  // the layers above and below. Each slit is closed along the edge (joined across the gaps in
+  // ring order), so each is a closed crack of its own inside the body.
+  TissueModel model = mask_model({4, 4, 3}, box_voxels({4, 4, 3}));
+  const auto cell = [&](int x, int y) { return model.volume.cell_at_voxel({x, y, 1}); };
+  model.volume.cut_links(std::vector<CellFace>{{cell(1, 1), 1}, {cell(1, 2), 1}, {cell(1, 1), 3}, {cell(2, 1), 3}});
+  const SurfaceTopology t = topology_of(build_render_surface(model));
+  EXPECT_TRUE(t.closed_and_oriented()) << t.non_manifold_edges << " non-manifold, " << t.misoriented_edges
+                                       << " misoriented";
+  EXPECT_EQ(t.components, 5);  // the box's outside and four cracks
+  EXPECT_EQ(t.euler_characteristic(), 10);
+}
+
 TEST(RenderSurface, MaskModelIsSmoothedButClosed) {
   std::vector<Vec3i> voxels;
   for (int z = 0; z < 3; ++z)
