@@ -118,12 +118,15 @@ test('the round-incision preview opens the incisions once stroke and magnitude a
     const r = await waitForResult(page, seq);
     assert.equal(r.design_error, undefined, r.design_error);
     assert.ok(r.incisions.length >= 5, `preview incisions measured: ${r.incisions.length}`);
-    // The incisions are cut (holes in the surface, plugs hidden) and their margins move when the
-    // designed stress is released. The sign follows the design: on the free abdomen the
-    // least-squares design (equilibration off) leaves many margins slightly closing, which the
-    // stress design owner is told about (docs/studio.md); here we assert that they respond.
-    const moved = r.incisions.filter((i) => Math.abs(i.opening_mm) > 0.05);
-    assert.ok(moved.length >= 3, `margins moved by more than 0.05 mm: ${moved.length} of ${r.incisions.length} (${r.incisions.map((i) => i.opening_mm.toFixed(2))})`);
+    // The incisions are cut (holes in the surface, plugs hidden) and open when the designed stress
+    // is released: with the demo's settings (w_E = 0, equilibrated, rim and inner surface held) the
+    // skin is in tension everywhere, so every margin opens by a fraction of a millimetre to a few
+    // (the demo at 3.6 mm cells: mean axis ratio 1.10) into an ellipse.
+    const openings = r.incisions.map((i) => i.opening_mm.toFixed(2)).join(', ');
+    assert.ok(r.incisions.every((i) => i.opening_mm > 0.1 && i.opening_mm < 5), `openings (mm): ${openings}`);
+    const meanRatio = r.incisions.reduce((a, i) => a + i.axis_ratio, 0) / r.incisions.length;
+    assert.ok(meanRatio > 1.02 && meanRatio < 1.3, `mean axis ratio ${meanRatio}`);
+    assert.match(await page.locator('#preview-info').textContent(), /^opening \d+\.\d\d to \d+\.\d\d mm .*axis ratio 1\.\d{3}$/);
     assert.ok(r.surface.triangles.length < r0Triangles, 'the incision plugs are hidden from the surface');
     assert.ok(r.fields.displacement_mm.some((d) => d > 0.01), 'the surface is displaced');
     assert.ok(r.timings_ms.total > 0 && Number.isFinite(r.timings_ms.total));
@@ -133,7 +136,10 @@ test('the round-incision preview opens the incisions once stroke and magnitude a
     // Eigenvalue map with its legend in kPa; the equilibrium residual; the incisions' cut faces.
     await page.selectOption('#display', 'langer');
     assert.match(await page.locator('#legend .title').textContent(), /Eigenvalue along Langer \(kPa\)/);
-    assert.ok(Number(await page.locator('#legend .hi').textContent()) > Number(await page.locator('#legend .lo').textContent()));
+    // Five control points of 20 kPa with w_E = 0 (the demo's settings): 20 kPa all over, or a range.
+    const title = await page.locator('#legend .title').textContent();
+    assert.ok(Number(await page.locator('#legend .hi').textContent()) > Number(await page.locator('#legend .lo').textContent()) ||
+      /uniform 20\.00/.test(title), title);
     await screenshot(page, '04a-eigenvalue-langer');
     await page.selectOption('#display', 'residual');
     assert.match(await page.locator('#legend .title').textContent(), /Equilibrium residual .*\(kPa\)/);

@@ -169,7 +169,10 @@ export class Viewer {
     const onCut = (v) => !scalar[4] || v >= 0;
     let lo = Infinity, hi = -Infinity;
     if (shown) for (const v of values) if (onCut(v)) { lo = Math.min(lo, v); hi = Math.max(hi, v); }
-    if (!(hi > lo)) { lo = Number.isFinite(lo) ? lo : 0; hi = lo + 1; }
+    // A uniform field (e.g. the residual of an exactly equilibrated design): one colour, and the
+    // legend says so instead of inventing a range.
+    const uniform = !(hi > lo);
+    if (uniform) { lo = Number.isFinite(lo) ? lo : 0; hi = lo + 1; }
     for (let i = 0; i < n; i++) {
       const c = shown && onCut(values[i]) ? rampColor(scalar[3], (values[i] - lo) / (hi - lo)) : BODY_COLOR;
       colors.setXYZ(i, c[0], c[1], c[2]);
@@ -177,11 +180,12 @@ export class Viewer {
     colors.needsUpdate = true;
     if (scalar) {
       legend.hidden = false;
-      legend.querySelector('.title').textContent = shown ? `${scalar[1]} (${scalar[2]})` : `${scalar[1]}: not computed yet`;
+      legend.querySelector('.title').textContent = !shown ? `${scalar[1]}: not computed yet`
+        : uniform ? `${scalar[1]} (${scalar[2]}): uniform ${lo.toFixed(2)}` : `${scalar[1]} (${scalar[2]})`;
       legend.querySelector('.ramp').style.background = rampCss(scalar[3]);
       const digits = hi - lo < 0.1 ? 4 : 2;
       legend.querySelector('.lo').textContent = shown ? `${lo.toFixed(digits)}` : '';
-      legend.querySelector('.hi').textContent = shown ? `${hi.toFixed(digits)}` : '';
+      legend.querySelector('.hi').textContent = shown ? `${(uniform ? lo : hi).toFixed(digits)}` : '';
     } else {
       legend.hidden = true;
     }
