@@ -107,6 +107,9 @@ struct Sector {
 /// both ends of the edge choose the same pairs.
 PartnerOverrides edge_overrides(const LinkedVolume& volume, const CornerCells& cells) {
   PartnerOverrides overrides{};
+  PerOctantFace<bool> on_surface{};
+  for (int k = 0; k < kCornerCount; ++k)
+    for (int a = 0; a < 3; ++a) on_surface[static_cast<size_t>(k)][static_cast<size_t>(a)] = boundary(volume, cells, k, a);
   for (int e = 0; e < 3; ++e)
     for (int side = 0; side < 2; ++side) {
       // The 4 octants around the edge from g along axis e (towards +e for side 0), in ring order.
@@ -115,14 +118,17 @@ PartnerOverrides edge_overrides(const LinkedVolume& volume, const CornerCells& c
       std::array<int, 4> ring{};
       for (size_t i = 0; i < 4; ++i) ring[i] = (side << e) | (kQuadUv[i][0] << u) | (kQuadUv[i][1] << v);
       // A sector ends where the face towards the next octant in the ring is on the surface.
-      std::array<Sector, 4> sectors{};
+      std::array<OctantFace, 4> ends_at{};
       size_t count = 0;
       for (size_t i = 0; i < 4; ++i) {
         const int k = ring[i];
         const int axis = std::countr_zero(static_cast<unsigned>(k ^ ring[(i + 1) % 4]));
-        if (boundary(volume, cells, k, axis)) sectors[count++] = {material_partner(volume, cells, k, axis, e), {k, axis}};
+        if (on_surface[static_cast<size_t>(k)][static_cast<size_t>(axis)]) ends_at[count++] = {k, axis};
       }
       if (count < 2) continue;
+      std::array<Sector, 4> sectors{};
+      for (size_t i = 0; i < count; ++i)
+        sectors[i] = {material_partner(volume, cells, ends_at[i].k, ends_at[i].a, e), ends_at[i]};
       // Linked-volume vertices of a sector at this corner and at the other end of the edge.
       const auto ends = [&](const Sector& s) {
         const CellId c = cells[static_cast<size_t>(s.end.k)];
