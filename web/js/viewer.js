@@ -218,13 +218,52 @@ export class Viewer {
 
   buildStreamlines(lines) {
     if (!lines) return;
-    // Each line is a flat [x, y, z, x, y, z, ...] array (mm); drawn as one set of segments.
+    // Each line is a flat [x, y, z, x, y, z, ...] array (mm), traced through the volume's cells:
+    // inside a thin wall it would hide under the skin, so each point is drawn on the surface
+    // nearest to it, lifted slightly along the normal (paper fig. 6 shows them on the skin).
+    // Drawn as one set of segments.
+    const onSurface = this.surfaceProjector();
     const pts = [];
-    for (const line of lines)
-      for (let i = 3; i < line.length; i += 3) pts.push(line[i - 3], line[i - 2], line[i - 1], line[i], line[i + 1], line[i + 2]);
+    for (const line of lines) {
+      let prev = null;
+      for (let i = 0; i < line.length; i += 3) {
+        const p = onSurface(line[i], line[i + 1], line[i + 2]);
+        if (prev && p) pts.push(...prev, ...p);
+        prev = p;
+      }
+    }
     const g = new THREE.BufferGeometry();
     g.setAttribute('position', new THREE.Float32BufferAttribute(pts, 3));
     this.fieldOverlay.add(new THREE.LineSegments(g, new THREE.LineBasicMaterial({ color: 0xffd400 })));
+  }
+
+  /// (x, y, z) -> its projection onto the tangent plane of the nearest surface vertex (within 1.5
+  /// cells), lifted by 0.15 cell along that vertex's normal, or null; a hash of the vertices by
+  /// cell keeps it linear.
+  surfaceProjector() {
+    const pos = this.mesh.geometry.attributes.position, nrm = this.mesh.geometry.attributes.normal;
+    const h = Math.max(1e-3, this.result.cell_size_mm || 1);
+    const key = (i, j, k) => `${i},${j},${k}`;
+    const grid = new Map();
+    for (let v = 0; v < pos.count; v++) {
+      const k = key(Math.floor(pos.array[3 * v] / h), Math.floor(pos.array[3 * v + 1] / h), Math.floor(pos.array[3 * v + 2] / h));
+      if (!grid.has(k)) grid.set(k, []);
+      grid.get(k).push(v);
+    }
+    return (x, y, z) => {
+      const ci = Math.floor(x / h), cj = Math.floor(y / h), ck = Math.floor(z / h);
+      let best = -1, bestD = (1.5 * h) ** 2;
+      for (let a = -1; a <= 1; a++) for (let b = -1; b <= 1; b++) for (let c = -1; c <= 1; c++)
+        for (const v of grid.get(key(ci + a, cj + b, ck + c)) || []) {
+          const d = (pos.array[3 * v] - x) ** 2 + (pos.array[3 * v + 1] - y) ** 2 + (pos.array[3 * v + 2] - z) ** 2;
+          if (d < bestD) { bestD = d; best = v; }
+        }
+      if (best < 0) return null;
+      // Along the vertex normal onto the vertex's tangent plane (keeps the line smooth), then lifted.
+      const n = [0, 1, 2].map((k) => nrm.array[3 * best + k]);
+      const along = n[0] * (pos.array[3 * best] - x) + n[1] * (pos.array[3 * best + 1] - y) + n[2] * (pos.array[3 * best + 2] - z);
+      return [x, y, z].map((c, k) => c + (along + 0.15 * h) * n[k]);
+    };
   }
 
   /// Draws the design: strokes (red), cut paths (dark), control points with their tensor frame.
