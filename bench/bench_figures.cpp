@@ -26,6 +26,7 @@ std::string_view stage_key(Stage stage) {
   switch (stage) {
     case Stage::vector: return "vector";
     case Stage::value: return "value";
+    case Stage::value_point: return "value_point";
     case Stage::equilibrate: return "equilibrate";
     case Stage::preview: return "preview";
     case Stage::step: return "step";
@@ -38,6 +39,7 @@ StageFigures& ImplementationFigures::stage(Stage s) {
   switch (s) {
     case Stage::vector: return vector;
     case Stage::value: return value;
+    case Stage::value_point: return value_point;
     case Stage::equilibrate: return equilibrate;
     case Stage::preview: return preview;
     case Stage::step: return step;

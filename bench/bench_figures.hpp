@@ -5,7 +5,9 @@
 //
 // Stages (keys as in the JSON output):
 //   vector       eigenvector interpolation: Langer and normal line fields, orthonormalization
-//   value        eigenvalue interpolation: Laplacian + control points + equilibrium (least squares)
+//   value        eigenvalue interpolation after a stroke edit: Laplacian + control points +
+//                equilibrium (least squares); nothing to redo when w_E = 0 (frames do not enter)
+//   value_point  the same after a control-point edit (add, move, delete in turn)
 //   equilibrate  making the designed stress exactly self-balanced
 //   preview      one incision-preview solve: statics of the body with round incisions cut
 //   step         one implicit corotational Newmark step during an ongoing cut
@@ -34,10 +36,10 @@ std::string_view implementation_key(Implementation implementation);
 /// Inverse of implementation_key; throws InputError naming `option` and listing the keys.
 Implementation implementation_from_key(std::string_view key, std::string_view option);
 
-enum class Stage { vector, value, equilibrate, preview, step, update };
-inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value, Stage::equilibrate,
+enum class Stage { vector, value, value_point, equilibrate, preview, step, update };
+inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value, Stage::value_point, Stage::equilibrate,
                                        Stage::preview, Stage::step, Stage::update};
-/// "vector", "value", "equilibrate", "preview", "step", "update".
+/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update".
 std::string_view stage_key(Stage stage);
 
 struct StageFigures {
@@ -51,7 +53,7 @@ struct StageFigures {
 struct ImplementationFigures {
   Implementation implementation = Implementation::cleave;
   std::string solver;  ///< the solver's own name as it reports it
-  StageFigures vector, value, equilibrate, preview, step, update;
+  StageFigures vector, value, value_point, equilibrate, preview, step, update;
   double peak_mb = 0;  ///< peak resident memory while this implementation ran (MB = 1e6 bytes)
 
   StageFigures& stage(Stage s);
@@ -63,6 +65,7 @@ struct ModelFigures {
   int cells = 0;
   int vertices = 0;
   int incisions = 0;  ///< round incisions in the preview
+  double design_equilibrium_weight = 0;  ///< w_E of the design stages (value, value_point)
   std::int64_t stiffness_nonzeros = 0;  ///< stored entries of K of the incised body (bandwidth estimates)
   ImplementationFigures cleave;
   std::vector<ImplementationFigures> peers;

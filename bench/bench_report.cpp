@@ -61,6 +61,7 @@ nlohmann::json model_figures_json(const ModelFigures& figures, const MachineFigu
   j["cells"] = figures.cells;
   j["vertices"] = figures.vertices;
   j["incisions"] = figures.incisions;
+  j["design_equilibrium_weight"] = figures.design_equilibrium_weight;
   j["stiffness_nonzeros"] = figures.stiffness_nonzeros;
   j["machine"] = {{"cpu", machine.cpu},
                   {"threads", machine.threads},

@@ -19,6 +19,31 @@ DesignStroke stroke_of_edit(const BenchScenario& scenario, int edit) {
   return edit % 2 == 0 ? scenario.edited_stroke : scenario.design.strokes.front();
 }
 
+DesignControlPoint middle_of(const DesignStroke& stroke) {
+  return {stroke.points_mm[stroke.points_mm.size() / 2], 25.0, 15.0};
+}
+
+/// Control-point edit number `edit`: add, move, delete in turn (the added point is the last one).
+void control_point_edit(StressDesigner& designer, const BenchScenario& scenario, int edit) {
+  switch (edit % 3) {
+    case 0: designer.add_control_point(middle_of(scenario.edited_stroke)); break;
+    case 1:
+      designer.move_control_point(designer.design().control_points.size() - 1, middle_of(scenario.design.strokes.front()));
+      break;
+    default: designer.delete_control_point(designer.design().control_points.size() - 1); break;
+  }
+}
+
+/// Times `repeat` control-point edits (ms of the eigenvalue stage of each).
+std::vector<double> time_control_point_edits(StressDesigner& designer, const BenchScenario& scenario, int repeat) {
+  std::vector<double> value_ms;
+  for (int edit = 0; edit < repeat; ++edit) {
+    control_point_edit(designer, scenario, edit);
+    value_ms.push_back(kMsPerSecond * designer.result().timings.eigenvalues_s);
+  }
+  return value_ms;
+}
+
 Eigen::VectorXd flatten_eigenvalues(const std::vector<Vec3>& eigenvalues_kPa) {
   Eigen::VectorXd out(3 * static_cast<Eigen::Index>(eigenvalues_kPa.size()));
   for (std::size_t c = 0; c < eigenvalues_kPa.size(); ++c) out.segment<3>(3 * static_cast<Eigen::Index>(c)) = eigenvalues_kPa[c];
@@ -62,13 +87,15 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
     equilibrate_ms.push_back(kMsPerSecond * t.equilibration_s);
   }
   DesignOutcome out;
+  out.line_tensors = frame_line_tensors(designer.result().frames);
   out.vector.time = summarize_timings(vector_ms);
   out.value.time = summarize_timings(value_ms);
   out.value.iterations = designer.result().eigenvalue_iterations;
+  out.value_point.time = summarize_timings(time_control_point_edits(designer, scenario, repeat));
+  out.value_point.iterations = designer.result().eigenvalue_iterations;
   out.equilibrate.time = summarize_timings(equilibrate_ms);
   out.update.time = summarize_timings(update_ms);
   out.update.iterations = preview_iterations;
-  out.line_tensors = frame_line_tensors(designer.result().frames);
   out.eigenvalues_kPa = flatten_eigenvalues(designer.result().eigenvalues_kPa);
   return out;
 }
@@ -94,6 +121,8 @@ DesignOutcome measure_paper(const TissueModel& uncut, const BenchScenario& scena
   out.vector.iterations = paper_frames.iterations;
   out.value.time = summarize_timings(value_ms);
   out.value.iterations = designer.result().eigenvalue_iterations;
+  out.value_point.time = summarize_timings(time_control_point_edits(designer, scenario, repeat));
+  out.value_point.iterations = designer.result().eigenvalue_iterations;
   out.equilibrate.skipped = "the paper has no equilibration step";
   out.line_tensors = frame_line_tensors(paper_frames.frames);
   out.eigenvalues_kPa = flatten_eigenvalues(designer.result().eigenvalues_kPa);
@@ -113,7 +142,7 @@ DesignOutcome measure_design(const TissueModel& uncut, const BenchScenario& scen
   }
   DesignOutcome out;
   const std::string why = "cleave's design stages already use CHOLMOD (supernodal, analysis reused)";
-  out.vector.skipped = out.value.skipped = out.equilibrate.skipped = why;
+  out.vector.skipped = out.value.skipped = out.value_point.skipped = out.equilibrate.skipped = why;
   return out;
 }
 

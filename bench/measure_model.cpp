@@ -33,6 +33,7 @@ ImplementationResults run_implementation(const TissueModel& model, const BenchSc
   DesignOutcome design = measure_design(model, scenario, implementation, options.repeat);
   r.figures.vector = design.vector;
   r.figures.value = design.value;
+  r.figures.value_point = design.value_point;
   r.figures.equilibrate = design.equilibrate;
   r.figures.update = design.update;
   r.line_tensors = std::move(design.line_tensors);
@@ -69,7 +70,8 @@ StageFigures composite_update(const ImplementationFigures& cleave, const Impleme
 void compare_with_cleave(const ImplementationResults& cleave, ImplementationResults& peer) {
   if (peer.line_tensors.size() > 0) peer.figures.vector.relative_difference = relative_difference(peer.line_tensors, cleave.line_tensors);
   if (peer.eigenvalues_kPa.size() > 0)
-    peer.figures.value.relative_difference = relative_difference(peer.eigenvalues_kPa, cleave.eigenvalues_kPa);
+    peer.figures.value.relative_difference = peer.figures.value_point.relative_difference =
+        relative_difference(peer.eigenvalues_kPa, cleave.eigenvalues_kPa);
   peer.figures.preview.relative_difference = relative_difference(peer.preview_mm, cleave.preview_mm);
   peer.figures.step.relative_difference = relative_difference(peer.step_mm, cleave.step_mm);
 }
@@ -89,13 +91,15 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
       make_tissue_model(bench_model.shape, make_builtin_shape(bench_model.shape, {bench_model.cells, std::nullopt}));
   ScenarioOptions scenario_options;
   scenario_options.cut_segments = kWarmUpSteps + std::max(options.repeat, 1);
-  const BenchScenario scenario = make_bench_scenario(model, scenario_options);
+  BenchScenario scenario = make_bench_scenario(model, scenario_options);
+  if (options.design_equilibrium_weight) scenario.design.weights.equilibrium = *options.design_equilibrium_weight;
 
   ModelFigures figures;
   figures.model = bench_model;
   figures.cells = model.volume.cell_count();
   figures.vertices = model.volume.vertex_count();
   figures.incisions = static_cast<int>(scenario.incisions.incisions.size());
+  figures.design_equilibrium_weight = scenario.design.weights.equilibrium;
 
   const double share = 1.0 / static_cast<double>(1 + options.peers.size());
   const ImplementationResults cleave =

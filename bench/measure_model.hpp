@@ -10,6 +10,7 @@
 // single-threaded or direct solver would take minutes and tens of GB. Progress goes to
 // `progress` (stage name, fraction of this model done). Errors: InputError for a bad scenario,
 // ComputeError when a solver fails.
+#include <optional>
 #include <vector>
 
 #include "bench_figures.hpp"
@@ -21,6 +22,8 @@ struct BenchOptions {
   int repeat = 5;  ///< timed runs per stage (medians over these)
   std::vector<Implementation> peers = {Implementation::paper, Implementation::eigen_cg, Implementation::cholmod};
   int peer_max_cells = 400'000;  ///< peers are skipped on larger models
+  /// w_E of the design stages (eq. 6 rows in the eigenvalue least squares); unset = the default design's.
+  std::optional<double> design_equilibrium_weight;
 };
 
 ModelFigures measure_model(const BenchModel& model, const BenchOptions& options, const ProgressFn& progress);

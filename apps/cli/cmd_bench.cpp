@@ -8,8 +8,10 @@
 //   cleave bench --models scaling --peers none --scaling docs/performance-scaling.tsv
 #include <fmt/format.h>
 
+#include <cmath>
 #include <cstdio>
 #include <fstream>
+#include <optional>
 #include <sstream>
 
 #include "bench_models.hpp"
@@ -30,6 +32,7 @@ struct BenchArguments {
   std::string scaling_file;  ///< per-cell times of every measured model, tab separated
   int repeat = 5;
   int peer_max_cells = 400'000;
+  std::optional<double> design_equilibrium;  ///< w_E of the design stages; unset = the default design's
   bool large = false;
   bool quick = false;
   bool json = false;
@@ -98,6 +101,9 @@ int run_bench(const BenchArguments& args) {
   options.repeat = args.repeat;
   options.peers = selected_peers(args.peers);
   options.peer_max_cells = args.peer_max_cells;
+  if (args.design_equilibrium && !(*args.design_equilibrium >= 0.0 && std::isfinite(*args.design_equilibrium)))
+    throw InputError(fmt::format("--design-equilibrium {}: expected a finite weight >= 0", *args.design_equilibrium));
+  options.design_equilibrium_weight = args.design_equilibrium;
   const ProgressFn progress = stderr_progress(args.quiet);
 
   report(progress, "memory bandwidth", 0.0);
@@ -139,6 +145,8 @@ const CommandRegistrar kBench{{"bench", 90, [](CLI::App& app) -> std::function<i
                                  cmd->add_option("--peers", args->peers, "peers to run: paper, eigen_cg, cholmod (comma-separated) or none")
                                      ->capture_default_str();
                                  cmd->add_option("--peer-max-cells", args->peer_max_cells, "skip peers on larger models")->capture_default_str();
+                                 cmd->add_option("--design-equilibrium", args->design_equilibrium,
+                                                 "w_E of the design stages (default: the design default, 0)");
                                  cmd->add_option("--scaling", args->scaling_file, "write per-cell times of every model to this tab-separated file");
                                  cmd->add_flag("--json", args->json, "print one JSON object per model per line");
                                  cmd->add_flag("--quiet,-q", args->quiet, "no progress output");
