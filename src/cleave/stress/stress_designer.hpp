@@ -8,8 +8,10 @@
 //                            one solve with the kept eigenvalue factor
 // Warm start: every factorization (Langer field, eigenvalues, the equilibration's Kc) is kept;
 // after an edit it preconditions CG on the edited system from the previous solution, and a
-// system is refactorized only when that CG is off track (stroke edits of the Langer field). The
-// paper CG starts from the previous eigenvalues. An edit gives the same result as a fresh
+// system is refactorized only when that CG is off track or would cost more than a new factor
+// (stroke edits of the Langer field; SparseCholesky::solve_with_current_factor decides on
+// measured times). The paper CG starts from the previous eigenvalues. Non-finite intermediate
+// results are ComputeErrors naming the stage, never a NaN in the result. An edit gives the same result as a fresh
 // designer with the final design (within solver tolerance).
 //
 //   StressDesigner designer(model, design);         // computes everything; InputError on bad design
