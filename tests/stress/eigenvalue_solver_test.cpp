@@ -63,9 +63,11 @@ TEST_P(SolverAgreement, PaperCgAndTheDefaultAgreeAfterASequenceOfEdits) {
 
 INSTANTIATE_TEST_SUITE_P(EquilibriumWeights, SolverAgreement, ::testing::Values(0.0, 1.0));
 
-TEST(EigenvalueEdits, AValueChangeIsOneSolveAndAMoveReusesTheFactor) {
-  // 4k cells: large enough that a factorization costs much more than the few CG iterations of a
-  // move (the kept factor's CG is chosen on measured costs).
+TEST(EigenvalueEdits, AValueChangeIsOneSolveAndAMoveEqualsAFreshSolve) {
+  // 4k cells: large enough that a factorization usually costs much more than the few CG
+  // iterations of a move. Which path a move takes is chosen on measured costs (a loaded machine
+  // may choose either), so the move is checked for its result and, when the kept factor's CG ran,
+  // for its iteration count; the bench measures the time.
   const TissueModel m = test::builtin_model("plate", {Vec3i(32, 32, 4), std::nullopt});
   const std::vector<DirectionFrame> frames(static_cast<std::size_t>(m.volume.cell_count()));
   const double tolerance_mm = 5.0;
@@ -87,9 +89,12 @@ TEST(EigenvalueEdits, AValueChangeIsOneSolveAndAMoveReusesTheFactor) {
   points[0].position_mm = Vec3(40, 30, 10);  // two diagonal entries change: CG with the kept factor
   points.push_back({{60, 40, 10}, 10, 10});  // and a third
   s = interp.solve(frames, control_point_targets(m, points, tolerance_mm), EigenvalueSolver::cholesky, s.eigenvalues_kPa);
-  EXPECT_EQ(interp.factorizations(), 1);
-  EXPECT_GT(s.iterations, 0);
-  EXPECT_LE(s.iterations, 2 * 8);  // about rank + 1 per right-hand side (two non-zero ones)
+  if (interp.factorizations() == 1) {
+    EXPECT_GT(s.iterations, 0);
+    EXPECT_LE(s.iterations, 2 * 8);  // about rank + 1 per right-hand side (two non-zero ones)
+  } else {
+    EXPECT_EQ(interp.factorizations(), 2);  // judged cheaper to refactorize: one new factor
+  }
   EigenvalueInterpolator fresh2(m.volume, DesignWeights{});
   EXPECT_LT(relative_difference(s.eigenvalues_kPa,
                                 fresh2.solve(frames, control_point_targets(m, points, tolerance_mm), EigenvalueSolver::cholesky)
