@@ -71,6 +71,15 @@ TEST(FuzzRegressions, NiftiDeclaringMoreSamplesThanTheFileHoldsIsRefusedBeforeAl
   EXPECT_EQ(error.rfind(file.string() + ": the image data is truncated or unreadable (expected ", 0), 0u) << error;
 }
 
+// fuzz_nifti (2 h campaign): a NIfTI-2 header stored byte-swapped (sizeof_hdr reads 540 only
+// swapped) whose dim[0] reads 1 as stored and 2^56 swapped: cleave checked the stored value,
+// nifticlib used the swapped one and overflowed its stack copying dim[1..dim[0]].
+TEST(FuzzRegressions, ByteSwappedNifti2DimensionCountIsJudgedSwapped) {
+  const auto file = kRegressions / "nifti" / "nifti2_swapped_dim0_overflow.nii";
+  EXPECT_EQ(error_of([&] { (void)read_nifti_volume(file); }),
+            file.string() + ": header dim[0] is 72057594037927936; expected 1 to 7 dimensions");
+}
+
 // fuzz_nrrd: bytes without the NRRD magic went to teem's other readers (plain text here), which
 // leak on their error paths.
 TEST(FuzzRegressions, NrrdWithoutMagicIsRefusedBeforeTeem) {

@@ -2,6 +2,7 @@
 // and permuted axes give the same world-space mask), LPS to RAS, resampling to a chosen cell
 // size, label selection and thresholds.
 #include <cstring>
+#include <fstream>
 #include <gmock/gmock.h>
 #include <gtest/gtest.h>
 #include <nifti2_io.h>
@@ -237,6 +238,46 @@ TEST(NiftiVolume, ScaledIntensitiesAndThreshold) {
   EXPECT_EQ(v.inside_count(), 500);
   EXPECT_NEAR(v.grid.origin_mm.x(), 4.5, 1e-12);
   for (Label l : v.labels) EXPECT_EQ(l, 1);
+}
+
+/// A minimal single-file NIfTI-1 (4 x 3 x 2 uint8 samples 0..23, pixdim 1.5 / 2 / 2.5 mm, no
+/// sform or qform) written field by field in the given byte order.
+void write_raw_nifti1(const std::filesystem::path& file, bool big_endian) {
+  std::vector<unsigned char> bytes(352 + 24, 0);
+  const auto put = [&](std::size_t offset, const auto value) {
+    unsigned char raw[sizeof(value)];
+    std::memcpy(raw, &value, sizeof(value));
+    for (std::size_t i = 0; i < sizeof(value); ++i) bytes[offset + i] = raw[big_endian ? sizeof(value) - 1 - i : i];
+  };
+  put(0, std::int32_t{348});
+  const std::int16_t dims[8] = {3, 4, 3, 2, 1, 1, 1, 1};
+  for (int i = 0; i < 8; ++i) put(40 + 2 * static_cast<std::size_t>(i), dims[i]);
+  put(70, std::int16_t{DT_UINT8});
+  put(72, std::int16_t{8});
+  const float pixdim[8] = {1.0f, 1.5f, 2.0f, 2.5f, 1.0f, 1.0f, 1.0f, 1.0f};
+  for (int i = 0; i < 8; ++i) put(76 + 4 * static_cast<std::size_t>(i), pixdim[i]);
+  put(108, 352.0f);  // vox_offset
+  bytes[123] = NIFTI_UNITS_MM;
+  std::memcpy(bytes.data() + 344, "n+1", 4);
+  for (int i = 0; i < 24; ++i) bytes[352 + static_cast<std::size_t>(i)] = static_cast<unsigned char>(i);
+  std::ofstream(file, std::ios::binary).write(reinterpret_cast<const char*>(bytes.data()), static_cast<std::streamsize>(bytes.size()));
+}
+
+TEST(NiftiVolume, BigEndianFileReadsLikeItsLittleEndianTwin) {
+  // nifticlib swaps a header whose sizeof_hdr is stored in the other byte order; cleave's own
+  // header checks (dim[0], pixdim) must read it the same way (they refused such files with
+  // "dim[0] is 768" before).
+  TempFolder tmp;
+  write_raw_nifti1(tmp / "little.nii", false);
+  write_raw_nifti1(tmp / "big.nii", true);
+  const ImageVolume little = read_nifti_volume(tmp / "little.nii");
+  const ImageVolume big = read_nifti_volume(tmp / "big.nii");
+  EXPECT_EQ(little.dims, Vec3i(4, 3, 2));
+  EXPECT_EQ(big.dims, little.dims);
+  EXPECT_EQ(big.index_to_world, little.index_to_world);
+  EXPECT_EQ(little.index_to_world.diagonal(), Vec3(1.5, 2.0, 2.5));
+  EXPECT_EQ(big.values, little.values);
+  EXPECT_EQ(little.values.back(), 23.0);
 }
 
 // ---------------------------------------------------------------------------------------------

@@ -34,10 +34,25 @@ double unit_to_mm(int xyz_units) {
 
 constexpr std::int64_t kMaxNiftiDims = 7;  // dim[0]: the number of dimensions, 1 to 7
 
+/// The header field as nifticlib will see it: byte-swapped when the header's size is stored in
+/// the other byte order.
+template <typename T>
+T in_file_order(T value, bool swapped) {
+  if (!swapped) return value;
+  T out;
+  auto* dst = reinterpret_cast<unsigned char*>(&out);
+  const auto* src = reinterpret_cast<const unsigned char*>(&value);
+  for (std::size_t i = 0; i < sizeof(T); ++i) dst[i] = src[sizeof(T) - 1 - i];
+  return out;
+}
+
 /// Raw pixdim[1..3] of the header on disk (nifticlib replaces a zero pixdim by 1 when it builds
 /// the image, which would hide a broken file). Also refuses a dim[0] outside 1..7 before
 /// nifti_image_read sees it: nifticlib copies dim[1..dim[0]] into a fixed array of 8 (a
-/// NIfTI-2 header with dim[0] = 2^32 + 3 overflowed its stack; found by fuzz_nifti).
+/// NIfTI-2 header with dim[0] = 2^32 + 3 overflowed its stack; found by fuzz_nifti). The header
+/// comes as stored; nifticlib swaps it when sizeof_hdr is stored in the other byte order, so
+/// dim[0] is judged in that order too (a byte-swapped NIfTI-2 header whose dim[0] read 1 as
+/// stored and 2^56 swapped overflowed the same array; found by the 2 h fuzz_nifti run).
 Vec3 raw_pixdims(const std::string& f) {
   int version = 0;
   void* header = nifti_read_header(f.c_str(), &version, /*check=*/1);
@@ -45,16 +60,26 @@ Vec3 raw_pixdims(const std::string& f) {
     throw InputError(fmt::format("{}: not a readable NIfTI-1/NIfTI-2 file (missing, truncated or malformed header)", f));
   Vec3 pixdim;
   std::int64_t dimensions = 0;
+  std::int64_t header_size = 0;
+  const std::int64_t expected_size = version == 2 ? 540 : 348;
+  bool swapped = false;
   if (version == 2) {
     const auto* h = static_cast<const nifti_2_header*>(header);
-    pixdim = {h->pixdim[1], h->pixdim[2], h->pixdim[3]};
-    dimensions = h->dim[0];
+    swapped = h->sizeof_hdr != expected_size && in_file_order(h->sizeof_hdr, true) == expected_size;
+    header_size = in_file_order(h->sizeof_hdr, swapped);
+    for (int a = 0; a < 3; ++a) pixdim[a] = in_file_order(h->pixdim[a + 1], swapped);
+    dimensions = in_file_order(h->dim[0], swapped);
   } else {
     const auto* h = static_cast<const nifti_1_header*>(header);
-    pixdim = {static_cast<double>(h->pixdim[1]), static_cast<double>(h->pixdim[2]), static_cast<double>(h->pixdim[3])};
-    dimensions = h->dim[0];
+    swapped = h->sizeof_hdr != expected_size && in_file_order(h->sizeof_hdr, true) == expected_size;
+    header_size = in_file_order(h->sizeof_hdr, swapped);
+    for (int a = 0; a < 3; ++a) pixdim[a] = static_cast<double>(in_file_order(h->pixdim[a + 1], swapped));
+    dimensions = in_file_order(h->dim[0], swapped);
   }
   std::free(header);
+  if (header_size != expected_size)
+    throw InputError(fmt::format("{}: header size (sizeof_hdr) is {}; expected {} for NIfTI-{}", f, header_size,
+                                 expected_size, version == 2 ? 2 : 1));
   if (dimensions < 1 || dimensions > kMaxNiftiDims)
     throw InputError(fmt::format("{}: header dim[0] is {}; expected 1 to 7 dimensions", f, dimensions));
   return pixdim;
