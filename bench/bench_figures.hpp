@@ -67,6 +67,9 @@ struct ModelFigures {
   int incisions = 0;  ///< round incisions in the preview
   double design_equilibrium_weight = 0;  ///< w_E of the design stages (value, value_point)
   std::int64_t stiffness_nonzeros = 0;  ///< stored entries of K of the incised body (bandwidth estimates)
+  /// Where the residual stress of the preview and the step came from: "design" (the scenario's
+  /// design) or "prescribed" (uniform biaxial, when the design stages were skipped).
+  std::string residual_stress = "design";
   ImplementationFigures cleave;
   std::vector<ImplementationFigures> peers;
 };

@@ -63,6 +63,7 @@ nlohmann::json model_figures_json(const ModelFigures& figures, const MachineFigu
   j["incisions"] = figures.incisions;
   j["design_equilibrium_weight"] = figures.design_equilibrium_weight;
   j["stiffness_nonzeros"] = figures.stiffness_nonzeros;
+  j["residual_stress"] = figures.residual_stress;
   j["machine"] = {{"cpu", machine.cpu},
                   {"threads", machine.threads},
                   {"bandwidth_GB_per_s", machine.bandwidth.all_threads_GB_per_s},
@@ -93,6 +94,17 @@ std::string stage_table(const std::vector<ModelFigures>& models) {
       out += fmt::format("{:<14} {:>8} {:<12} {:>22} {:>6}", m.model.key, m.cells, stage_key(s), range, st.iterations);
       for (const ImplementationFigures& peer : m.peers) out += fmt::format(" {:>10}", ms_text(peer.stage(s)));
       out += "\n";
+    }
+  for (const ModelFigures& m : models)  // why a stage was not run for cleave, once per model and reason
+    for (Stage s : kAllStages) {
+      const std::string& why = m.cleave.stage(s).skipped;
+      if (why.empty()) continue;
+      bool first = true;
+      for (Stage earlier : kAllStages) {
+        if (earlier == s) break;
+        if (m.cleave.stage(earlier).skipped == why) first = false;
+      }
+      if (first) out += fmt::format("{}: skipped ({}): {}\n", m.model.key, m.residual_stress == "prescribed" ? "design stages and update; preview and step on the prescribed 20/10 kPa stress" : stage_key(s), why);
     }
   return out;
 }

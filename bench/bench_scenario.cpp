@@ -106,13 +106,32 @@ StressDesign bench_design(const BodySurface& surface, const TissueModel& model) 
 
 }  // namespace
 
+std::vector<Vec6> prescribed_biaxial_stress(const TissueModel& model, double along_kPa, double axial_kPa) {
+  const auto [lo, hi] = model.bounding_box_mm();
+  const Vec3 centre = 0.5 * (lo + hi);
+  const Vec3 axis = Vec3::UnitZ();
+  const CellId cells = model.volume.cell_count();
+  std::vector<Vec6> stress(static_cast<std::size_t>(cells));
+  for (CellId c = 0; c < cells; ++c) {
+    const Vec3 p = model.volume.cell_center_mm(c);
+    const Vec3 circumferential(-(p.y() - centre.y()), p.x() - centre.x(), 0.0);
+    const double r = circumferential.norm();
+    Mat3 s = axial_kPa * axis * axis.transpose();
+    if (r > 0) s += along_kPa * (circumferential / r) * (circumferential / r).transpose();
+    stress[static_cast<std::size_t>(c)] = to_voigt(s);
+  }
+  return stress;
+}
+
 BenchScenario make_bench_scenario(const TissueModel& model, const ScenarioOptions& options) {
   const BodySurface surface(model);
   BenchScenario s;
   s.design = bench_design(surface, model);
   const auto [lo, hi] = model.bounding_box_mm();
   s.edited_stroke = stroke_across_top(surface, model, lo.z() + (hi.z() - lo.z()) / 3.0 + surface.cell_size_mm());
-  s.residual_stress_kPa = design_residual_stress(model, s.design).stress_kPa;
+  s.designed_stress = options.designed_stress;
+  s.residual_stress_kPa = s.designed_stress ? design_residual_stress(model, s.design).stress_kPa
+                                            : prescribed_biaxial_stress(model, kLangerTension_kPa, kCrossTension_kPa);
   s.incisions = spread_incisions(surface, model);
   if (s.incisions.incisions.empty())
     throw InputError(fmt::format("bench scenario: no round incision fits on the surface of {}", model.source));

@@ -5,7 +5,11 @@
 //     across the top of the body along x (the tube's circumference, the abdomen's horizontal
 //     lines) at 1/3 and 2/3 of its length, and five control points on top,
 //   - the edit of the edit-to-picture update: stroke 0 moved by one cell along z,
-//   - the residual stress of the body (one Voigt tensor per cell, kPa): the design's result,
+//   - the residual stress of the body (one Voigt tensor per cell, kPa): the design's result, or,
+//     where the design cannot run (`designed_stress = false`: models above
+//     `cleave bench --design-max-cells`, whose design factor would not fit in memory), a
+//     prescribed stress: 20 kPa along the circumference about the z axis (the strokes' direction
+//     on the tube), 10 kPa along z, 0 across the wall, in every cell,
 //   - the round incisions of the preview (paper section 5), spread over the outer surface,
 //   - the scalpel cut in progress during the dynamic steps, split into one segment per step.
 //
@@ -26,6 +30,8 @@ namespace cleave::bench {
 
 struct ScenarioOptions {
   int cut_segments = 8;  ///< pieces the scalpel cut is applied in (one per dynamic step)
+  /// false: no design is computed; the residual stress is the prescribed biaxial one (see above).
+  bool designed_stress = true;
 };
 
 struct BenchScenario {
@@ -34,7 +40,13 @@ struct BenchScenario {
   std::vector<Vec6> residual_stress_kPa;   ///< per cell of the uncut model
   CutRequests incisions;                   ///< the preview's round incisions
   std::vector<ScalpelCut> cut_segments;    ///< consecutive pieces of the ongoing scalpel cut
+  bool designed_stress = true;             ///< false: residual_stress_kPa is the prescribed one
 };
+
+/// The prescribed residual stress (kPa per cell): `along_kPa` along the circumference about the
+/// axis parallel to z through the centre of the bounding box, `axial_kPa` along z, 0 radially
+/// (cells on the axis get the axial part only).
+std::vector<Vec6> prescribed_biaxial_stress(const TissueModel& model, double along_kPa, double axial_kPa);
 
 /// Throws InputError when the model has no outer surface to place incisions on.
 BenchScenario make_bench_scenario(const TissueModel& model, const ScenarioOptions& options);

@@ -12,6 +12,8 @@
 #include <vector>
 
 #include "bench_models.hpp"
+#include "bench_scenario.hpp"
+#include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
 #include "timing_statistics.hpp"
 
@@ -26,8 +28,8 @@ constexpr double kAgreementTolerance = 1e-5;
 // and amplifies the CG's 1e-10 residual, so the frames agree to a looser bound.
 constexpr double kFrameAgreementTolerance = 1e-3;
 
-std::vector<nlohmann::json> run_quick_bench() {
-  const std::string command = std::string(CLEAVE_CLI_PATH) + " bench --quick --json --quiet";
+std::vector<nlohmann::json> run_quick_bench(const std::string& arguments = "--quick") {
+  const std::string command = std::string(CLEAVE_CLI_PATH) + " bench " + arguments + " --json --quiet";
   std::unique_ptr<FILE, int (*)(FILE*)> pipe(popen(command.c_str(), "r"), pclose);
   if (!pipe) return {};
   std::string output;
@@ -94,6 +96,41 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
       EXPECT_TRUE(p["relative_difference"].contains("step"));
       EXPECT_TRUE(p["relative_difference"].contains("preview"));
     }
+  }
+}
+
+TEST(BenchSmoke, AboveDesignMaxCellsTheDesignIsSkippedAndTheSolverStagesRunOnThePrescribedStress) {
+  const std::vector<nlohmann::json> lines = run_quick_bench("--models quick-tube --peers none --repeat 1 --design-max-cells 100");
+  ASSERT_EQ(lines.size(), 1u);
+  const nlohmann::json& m = lines.front();
+  EXPECT_EQ(m["residual_stress"], "prescribed");
+  for (const char* stage : {"vector", "value", "value_point", "equilibrate", "update"}) {
+    SCOPED_TRACE(stage);
+    EXPECT_TRUE(m["ms_" + std::string(stage)].is_null());
+    ASSERT_TRUE(m["skipped"].contains(stage));
+    EXPECT_NE(m["skipped"][stage].get<std::string>().find("--design-max-cells 100"), std::string::npos);
+  }
+  ASSERT_TRUE(m["ms_preview"].is_number());
+  ASSERT_TRUE(m["ms_step"].is_number());
+  EXPECT_GT(m["iterations"]["preview"].get<int>(), 0);
+  EXPECT_GT(m["iterations"]["step"].get<int>(), 0);
+}
+
+TEST(BenchScenario, PrescribedStressIsBiaxialAboutTheZAxis) {
+  TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", {Vec3i{12, 12, 10}, std::nullopt}));
+  const std::vector<Vec6> stress = prescribed_biaxial_stress(model, 20.0, 10.0);
+  ASSERT_EQ(stress.size(), static_cast<std::size_t>(model.volume.cell_count()));
+  const auto [lo, hi] = model.bounding_box_mm();
+  const Vec3 centre = 0.5 * (lo + hi);
+  for (CellId c = 0; c < model.volume.cell_count(); c += 17) {
+    const Mat3 s = from_voigt(stress[static_cast<std::size_t>(c)]);
+    Vec3 radial = model.volume.cell_center_mm(c) - centre;
+    radial.z() = 0;
+    radial.normalize();
+    const Vec3 around = Vec3::UnitZ().cross(radial);
+    EXPECT_NEAR(around.dot(s * around), 20.0, 1e-9);
+    EXPECT_NEAR(s(2, 2), 10.0, 1e-9);
+    EXPECT_NEAR(radial.dot(s * radial), 0.0, 1e-9);
   }
 }
 

@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <cmath>
+
 #include "cleave/core/error.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
@@ -22,22 +24,32 @@ struct ImplementationResults {
   std::int64_t stiffness_nonzeros = 0;
 };
 
+constexpr double kMeasuredDesignPeakGb = 4.2;       // tube-42 / cylinder-42, default design
+constexpr double kMeasuredDesignPeakCells = 44'064.0;
+constexpr double kNestedDissectionFillExponent = 4.0 / 3.0;
+
 ImplementationResults run_implementation(const TissueModel& model, const BenchScenario& scenario,
                                          Implementation implementation, const BenchOptions& options,
-                                         const ProgressFn& progress, double done, double share) {
+                                         const std::string& design_skipped, const ProgressFn& progress, double done,
+                                         double share) {
   ImplementationResults r;
   r.figures.implementation = implementation;
   reset_peak_resident_memory();
   const std::string who(implementation_key(implementation));
-  report(progress, who + ": design", done);
-  DesignOutcome design = measure_design(model, scenario, implementation, options.repeat);
-  r.figures.vector = design.vector;
-  r.figures.value = design.value;
-  r.figures.value_point = design.value_point;
-  r.figures.equilibrate = design.equilibrate;
-  r.figures.update = design.update;
-  r.line_tensors = std::move(design.line_tensors);
-  r.eigenvalues_kPa = std::move(design.eigenvalues_kPa);
+  if (design_skipped.empty()) {
+    report(progress, who + ": design", done);
+    DesignOutcome design = measure_design(model, scenario, implementation, options.repeat);
+    r.figures.vector = design.vector;
+    r.figures.value = design.value;
+    r.figures.value_point = design.value_point;
+    r.figures.equilibrate = design.equilibrate;
+    r.figures.update = design.update;
+    r.line_tensors = std::move(design.line_tensors);
+    r.eigenvalues_kPa = std::move(design.eigenvalues_kPa);
+  } else {
+    for (StageFigures* s : {&r.figures.vector, &r.figures.value, &r.figures.value_point, &r.figures.equilibrate, &r.figures.update})
+      s->skipped = design_skipped;
+  }
   report(progress, who + ": incision preview", done + 0.4 * share);
   MechanicsOutcome preview = measure_incision_preview(model, scenario, implementation, options.repeat);
   report(progress, who + ": dynamic step", done + 0.7 * share);
@@ -85,12 +97,28 @@ ImplementationFigures skipped(Implementation implementation, const std::string& 
 
 }  // namespace
 
+double design_memory_estimate_gb(int cells) {
+  return kMeasuredDesignPeakGb * std::pow(static_cast<double>(cells) / kMeasuredDesignPeakCells, kNestedDissectionFillExponent);
+}
+
 ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& options, const ProgressFn& progress) {
-  report(progress, fmt::format("{}: building", bench_model.key), 0.0);
+  const Vec3i& n = bench_model.cells;
+  report(progress, fmt::format("{}: building the {}x{}x{} grid", bench_model.key, n.x(), n.y(), n.z()), 0.0);
   const TissueModel model =
       make_tissue_model(bench_model.shape, make_builtin_shape(bench_model.shape, {bench_model.cells, std::nullopt}));
+  const int cells = model.volume.cell_count();
+  // Decided before anything is allocated for the design: its factors grow faster than the cells.
+  std::string design_skipped;
+  if (cells > options.design_max_cells)
+    design_skipped = fmt::format("design factor would need ~{:.0f} GB ({} cells is above --design-max-cells {})",
+                                 design_memory_estimate_gb(cells), cells, options.design_max_cells);
   ScenarioOptions scenario_options;
   scenario_options.cut_segments = kWarmUpSteps + std::max(options.repeat, 1);
+  scenario_options.designed_stress = design_skipped.empty();
+  report(progress,
+         fmt::format("{}: {} cells, scenario ({} residual stress)", bench_model.key, cells,
+                     design_skipped.empty() ? "designed" : "prescribed 20/10 kPa"),
+         0.0);
   BenchScenario scenario = make_bench_scenario(model, scenario_options);
   if (options.design_equilibrium_weight) scenario.design.weights.equilibrium = *options.design_equilibrium_weight;
 
@@ -100,10 +128,11 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
   figures.vertices = model.volume.vertex_count();
   figures.incisions = static_cast<int>(scenario.incisions.incisions.size());
   figures.design_equilibrium_weight = scenario.design.weights.equilibrium;
+  figures.residual_stress = scenario.designed_stress ? "design" : "prescribed";
 
   const double share = 1.0 / static_cast<double>(1 + options.peers.size());
   const ImplementationResults cleave =
-      run_implementation(model, scenario, Implementation::cleave, options, progress, 0.0, share);
+      run_implementation(model, scenario, Implementation::cleave, options, design_skipped, progress, 0.0, share);
   figures.cleave = cleave.figures;
   figures.stiffness_nonzeros = cleave.stiffness_nonzeros;
   for (std::size_t i = 0; i < options.peers.size(); ++i) {
@@ -114,13 +143,13 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
     }
     ImplementationResults r;
     try {
-      r = run_implementation(model, scenario, peer, options, progress, share * static_cast<double>(i + 1), share);
+      r = run_implementation(model, scenario, peer, options, design_skipped, progress, share * static_cast<double>(i + 1), share);
     } catch (const ComputeError& e) {  // a peer that fails (e.g. Eigen CG out of iterations) is reported, not fatal
       figures.peers.push_back(skipped(peer, fmt::format("failed: {}", e.what())));
       continue;
     }
     compare_with_cleave(cleave, r);
-    r.figures.update = composite_update(cleave.figures, r.figures);
+    if (design_skipped.empty()) r.figures.update = composite_update(cleave.figures, r.figures);
     figures.peers.push_back(std::move(r.figures));
   }
   report(progress, fmt::format("{}: done", bench_model.key), 1.0);

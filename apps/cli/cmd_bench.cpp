@@ -3,11 +3,13 @@
 //
 //   cleave bench                     the four Table 1 models, 5 repetitions, tables on stdout
 //   cleave bench --json              one JSON object per model per line (see bench/bench_report.hpp)
-//   cleave bench --large             also the tube at ~350k and >1M cells
+//   cleave bench --large             also the tube at ~350k and >1M cells (design stages skipped
+//                                    above --design-max-cells; preview and step on a prescribed stress)
 //   cleave bench --quick --json      tiny models, one repetition (smoke test; seconds)
 //   cleave bench --models scaling --peers none --scaling docs/performance-scaling.tsv
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <fstream>
@@ -32,6 +34,7 @@ struct BenchArguments {
   std::string scaling_file;  ///< per-cell times of every measured model, tab separated
   int repeat = 5;
   int peer_max_cells = 400'000;
+  int design_max_cells = 60'000;
   std::optional<double> design_equilibrium;  ///< w_E of the design stages; unset = the default design's
   bool large = false;
   bool quick = false;
@@ -61,7 +64,10 @@ std::vector<bench::BenchModel> selected_models(const BenchArguments& args) {
     else if (key == "quick") append(bench::quick_models());
     else models.push_back(bench::bench_model_by_key(key));
   }
-  if (args.large) append(bench::large_models());
+  if (args.large)
+    for (bench::BenchModel& m : bench::large_models())  // --models scaling --large: each tube once
+      if (std::none_of(models.begin(), models.end(), [&](const bench::BenchModel& known) { return known.key == m.key; }))
+        models.push_back(std::move(m));
   return models;
 }
 
@@ -77,12 +83,16 @@ std::vector<bench::Implementation> selected_peers(const std::string& list) {
   return peers;
 }
 
+/// One row per measured model: time per cell of every stage (us), then the medians (ms), the
+/// preview's and the step's iterations, the peak memory (MB) and where the stress came from.
+/// Rewritten after every model, so a long run leaves the models measured so far.
 void write_scaling_table(const std::string& path, const std::vector<bench::ModelFigures>& figures) {
   std::ofstream out(path);
   if (!out) throw InputError(fmt::format("--scaling {}: cannot write the file", path));
   out << "# model\tcells\tvertices";
   for (bench::Stage s : bench::kAllStages) out << "\tus_per_cell_" << bench::stage_key(s);
-  out << "\n";
+  for (bench::Stage s : bench::kAllStages) out << "\tms_" << bench::stage_key(s);
+  out << "\titerations_preview\titerations_step\tpeak_mb\tresidual_stress\n";
   for (const bench::ModelFigures& m : figures) {
     out << m.model.key << '\t' << m.cells << '\t' << m.vertices;
     for (bench::Stage s : bench::kAllStages) {
@@ -90,7 +100,13 @@ void write_scaling_table(const std::string& path, const std::vector<bench::Model
       if (st.time.count == 0) out << "\t-";  // gnuplot reads "-" as missing
       else out << '\t' << fmt::format("{:.4g}", 1000.0 * st.time.median_ms / m.cells);
     }
-    out << "\n";
+    for (bench::Stage s : bench::kAllStages) {
+      const bench::StageFigures& st = m.cleave.stage(s);
+      if (st.time.count == 0) out << "\t-";
+      else out << '\t' << fmt::format("{:.4g}", st.time.median_ms);
+    }
+    out << '\t' << m.cleave.preview.iterations << '\t' << m.cleave.step.iterations << '\t'
+        << fmt::format("{:.0f}", m.cleave.peak_mb) << '\t' << m.residual_stress << "\n";
   }
 }
 
@@ -101,6 +117,8 @@ int run_bench(const BenchArguments& args) {
   options.repeat = args.repeat;
   options.peers = selected_peers(args.peers);
   options.peer_max_cells = args.peer_max_cells;
+  if (args.design_max_cells < 0) throw InputError(fmt::format("--design-max-cells {}: expected at least 0", args.design_max_cells));
+  options.design_max_cells = args.design_max_cells;
   if (args.design_equilibrium && !(*args.design_equilibrium >= 0.0 && std::isfinite(*args.design_equilibrium)))
     throw InputError(fmt::format("--design-equilibrium {}: expected a finite weight >= 0", *args.design_equilibrium));
   options.design_equilibrium_weight = args.design_equilibrium;
@@ -122,8 +140,8 @@ int run_bench(const BenchArguments& args) {
       std::puts(bench::model_figures_json(figures.back(), machine).dump().c_str());
       std::fflush(stdout);
     }
+    if (!args.scaling_file.empty()) write_scaling_table(args.scaling_file, figures);
   }
-  if (!args.scaling_file.empty()) write_scaling_table(args.scaling_file, figures);
   if (args.json) return 0;
   fmt::print("machine: {}, {} threads, memory bandwidth (triad) {:.1f} GB/s all threads, {:.1f} GB/s one thread\n\n",
              machine.cpu, machine.threads, machine.bandwidth.all_threads_GB_per_s, machine.bandwidth.one_thread_GB_per_s);
@@ -139,12 +157,18 @@ const CommandRegistrar kBench{{"bench", 90, [](CLI::App& app) -> std::function<i
                                  auto* cmd = app.add_subcommand("bench", "time every stage on the paper's Table 1 models, with peers");
                                  cmd->add_option("--models", args->models,
                                                  "comma-separated models: table1, large, scaling, quick, or keys like cylinder-42, abdomen-126, tube-84");
-                                 cmd->add_flag("--large", args->large, "also the tube at 84x84x102 (~350k cells) and 120x120x146 (>1M cells)");
+                                 cmd->add_flag("--large", args->large,
+                                               "also the tube at 84x84x102 (~350k cells) and 120x120x146 (>1M cells); "
+                                               "design stages skipped there (see --design-max-cells)");
                                  cmd->add_flag("--quick", args->quick, "tiny models, one repetition: a smoke run of seconds");
                                  cmd->add_option("--repeat", args->repeat, "timed runs per stage (medians reported)")->capture_default_str();
                                  cmd->add_option("--peers", args->peers, "peers to run: paper, eigen_cg, cholmod (comma-separated) or none")
                                      ->capture_default_str();
                                  cmd->add_option("--peer-max-cells", args->peer_max_cells, "skip peers on larger models")->capture_default_str();
+                                 cmd->add_option("--design-max-cells", args->design_max_cells,
+                                                 "skip the design stages on larger models (their sparse Cholesky factors outgrow memory); "
+                                                 "preview and step then run on a prescribed 20/10 kPa biaxial stress")
+                                     ->capture_default_str();
                                  cmd->add_option("--design-equilibrium", args->design_equilibrium,
                                                  "w_E of the design stages (default: the design default, 0)");
                                  cmd->add_option("--scaling", args->scaling_file, "write per-cell times of every model to this tab-separated file");
