@@ -2,7 +2,7 @@
 // sideways load. A benchmark, not a test: DISABLED_ so that it runs only on request:
 //   cleave_test_fem --gtest_also_run_disabled_tests --gtest_filter='*DynamicsBenchmark*'
 // Environment: CLEAVE_BENCH_SOLVER (multigrid, eigen-cg, cholmod; default multigrid),
-// CLEAVE_BENCH_STEPS (default 20). Prints per-step times and iterations; asserts only that every
+// CLEAVE_BENCH_STEPS (default 20), CLEAVE_BENCH_STEP_TOLERANCE (DynamicsSettings::step_tolerance). Prints per-step times and iterations; asserts only that every
 // step converged.
 #include <gtest/gtest.h>
 
@@ -34,6 +34,7 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   if (solver != nullptr) settings.solver = solver_kind_from_name(solver);
   const char* steps_text = std::getenv("CLEAVE_BENCH_STEPS");
   const int steps = steps_text != nullptr ? std::atoi(steps_text) : 20;
+  if (const char* tol = std::getenv("CLEAVE_BENCH_STEP_TOLERANCE"); tol != nullptr) settings.step_tolerance = std::atof(tol);
   settings.mass_damping_per_s = 2.0;
   settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
   const double z0 = volume.grid().origin_mm.z();

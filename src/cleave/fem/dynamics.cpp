@@ -29,7 +29,11 @@ Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_k
   if (settings_.external_force_mN.size() != 0 && settings_.external_force_mN.size() != dofs)
     throw InputError(fmt::format("external force holds {} values; expected {} (3 per vertex)", settings_.external_force_mN.size(), dofs));
   table_ = make_element_table(model_);
-  solver_ = make_linear_solver(settings_.solver, settings_.solve);
+  if (!(settings_.step_tolerance >= 0 && settings_.step_tolerance < 1))
+    throw InputError(fmt::format("step tolerance is {}; expected a number from 0 to below 1", settings_.step_tolerance));
+  SolveSettings step_solve = settings_.solve;
+  step_solve.initial_residual_tolerance = settings_.step_tolerance;
+  solver_ = make_linear_solver(settings_.solver, step_solve);
   const FixedDofs held = fix_vertices(volume.vertex_count(), settings_.fixed_vertices);
   fixed_ = held.fixed;
   u_ = Vector::Zero(dofs);

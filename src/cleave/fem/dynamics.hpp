@@ -46,6 +46,12 @@ inline constexpr double kDivergedSizes = 1000.0;
 struct DynamicsSettings {
   SolverKind solver = SolverKind::multigrid_cg;
   SolveSettings solve;
+  /// The step's solve also stops when its force residual is below this times the residual of the
+  /// Newmark predictor it starts from (SolveSettings::initial_residual_tolerance, which this sets):
+  /// the error left in the increment is then this fraction of the step's correction of the
+  /// predictor, far below the time discretization error (O(dt^2) of that correction). 0: stop at
+  /// solve.relative_tolerance of the whole right-hand side alone (~2x the iterations).
+  double step_tolerance = 1e-5;
   double mass_damping_per_s = 0;        ///< Rayleigh alpha (1/s)
   double stiffness_damping_s = 0;       ///< Rayleigh beta (s)
   std::vector<VertexId> fixed_vertices; ///< held at zero displacement (vertices split off them too)

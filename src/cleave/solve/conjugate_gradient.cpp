@@ -1,5 +1,6 @@
 #include "cleave/solve/conjugate_gradient.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "cleave/solve/block_sparse_matrix.hpp"
@@ -14,13 +15,18 @@ constexpr int kMaxRestarts = 2;
 
 enum class CgStop { converged_recurrence, out_of_iterations, breakdown };
 
-/// Plain PCG from x; `iterations` is increased by the iterations done.
+/// Plain PCG from x; `iterations` is increased by the iterations done. When `initial_norm` is not
+/// null it receives ||b - A x|| of the start (before any iteration).
 template <typename Matrix>
-CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double target,
-               int max_iterations, int& iterations) {
+CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double& target,
+               double initial_factor, double* initial_norm, int max_iterations, int& iterations) {
   const Eigen::Index n = a.rows();
   Vector r(n), z(n), p(n), q(n);
   residual(a, b, x, r);
+  if (initial_norm != nullptr) {
+    *initial_norm = r.norm();
+    target = std::max(target, initial_factor * *initial_norm);
+  }
   if (r.norm() <= target) return CgStop::converged_recurrence;
   preconditioner.apply(r, z);
   p = z;
@@ -56,19 +62,25 @@ SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, c
     report.converged = std::isfinite(b_norm);
     return report;
   }
-  const double target = settings.relative_tolerance * b_norm;
+  // The looser of the two rules: relative to b, and relative to the initial guess's residual
+  // (which run_pcg measures at its start, the first time).
+  double target = settings.relative_tolerance * b_norm;
+  const double initial_factor = std::max(settings.initial_residual_tolerance, 0.0);
+  double initial_norm = 0;
   const Vector start = x;
   Vector r(n);
   double r_norm = 0;
   for (int restart = 0; restart <= kMaxRestarts; ++restart) {
-    const CgStop stop = run_pcg(a, b, x, preconditioner, target, settings.max_iterations, report.iterations);
+    const CgStop stop = run_pcg(a, b, x, preconditioner, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
+                                settings.max_iterations, report.iterations);
     if (!x.allFinite()) x = start;
     residual(a, b, x, r);
     r_norm = r.norm();
     if (stop != CgStop::converged_recurrence || r_norm <= target) break;
   }
   report.relative_residual = r_norm / b_norm;
-  report.converged = report.relative_residual <= settings.relative_tolerance;
+  report.initial_relative_residual = initial_norm / b_norm;
+  report.converged = r_norm <= target;
   return report;
 }
 

@@ -27,13 +27,18 @@ std::string_view solver_kind_name(SolverKind kind);
 
 struct SolveSettings {
   double relative_tolerance = 1e-8;  ///< stop when ||b - A x|| <= tol * ||b||
+  /// Also stop when ||b - A x|| <= this * ||b - A x0||, x0 the initial guess: the residual relative
+  /// to what the warm start left (the dynamic step's correction of its Newmark predictor). 0: off.
+  /// Read by the CG solvers of cleave (multigrid); the peers solve to relative_tolerance.
+  double initial_residual_tolerance = 0;
   int max_iterations = 2000;
 };
 
 struct SolveReport {
   int iterations = 0;
   double relative_residual = 0;  ///< ||b - A x|| / ||b|| reached
-  bool converged = false;
+  double initial_relative_residual = 0;  ///< ||b - A x0|| / ||b|| of the initial guess (CG solvers; 0 otherwise)
+  bool converged = false;  ///< relative_residual <= relative_tolerance, or the initial_residual_tolerance rule met
 };
 
 class LinearSolver {

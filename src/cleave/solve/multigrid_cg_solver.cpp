@@ -58,9 +58,14 @@ class MultigridCgSolver final : public LinearSolver {
         // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
         preconditioner_.use_double_precision(a_blocks_);
         const int spent = report.iterations;
+        const double initial = report.initial_relative_residual;
         attempt.max_iterations = settings_.max_iterations - spent;
+        // The initial-residual rule refers to the caller's initial guess, not to where float left x.
+        attempt.relative_tolerance = std::max(settings_.relative_tolerance, settings_.initial_residual_tolerance * initial);
+        attempt.initial_residual_tolerance = 0;
         report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
         report.iterations += spent;
+        report.initial_relative_residual = initial;
       }
     } else {
       report = preconditioned_cg(a_blocks_, b, x, preconditioner_, settings_);

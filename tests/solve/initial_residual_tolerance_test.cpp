@@ -1,0 +1,77 @@
+// SolveSettings::initial_residual_tolerance: the CG solvers of cleave also stop once the residual
+// is that fraction of the initial guess's residual (the dynamic step's rule), report it, and
+// otherwise behave as with relative_tolerance alone.
+#include <gtest/gtest.h>
+
+#include "cleave/solve/conjugate_gradient.hpp"
+#include "solve_test_systems.hpp"
+
+namespace cleave {
+namespace {
+
+TEST(InitialResidualTolerance, StopsAtThatFractionOfTheWarmStartResidual) {
+  TissueModel model = test::make_box({12, 4, 4}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  // A good warm start: the exact solution disturbed by 1 %.
+  Vector exact = Vector::Zero(s.b.size());
+  {
+    SolveSettings tight;
+    tight.relative_tolerance = 1e-11;
+    auto solver = make_linear_solver(SolverKind::multigrid_cg, tight);
+    solver->setup(s.a, model.volume);
+    ASSERT_TRUE(solver->solve(s.b, exact).converged);
+  }
+  Vector start = exact;
+  for (Eigen::Index i = 0; i < start.size(); ++i) start[i] *= 1.0 + 0.01 * std::sin(0.37 * static_cast<double>(i));
+  const double initial = (s.b - s.a * start).norm();
+
+  SolveSettings relative;  // 1e-8 of ||b||: many iterations from any start
+  SolveSettings from_start = relative;
+  from_start.initial_residual_tolerance = 1e-3;
+  for (const SolverKind kind : {SolverKind::multigrid_cg}) {
+    auto loose = make_linear_solver(kind, from_start);
+    loose->setup(s.a, model.volume);
+    Vector x = start;
+    const SolveReport r = loose->solve(s.b, x);
+    const double reached = (s.b - s.a * x).norm();
+    EXPECT_TRUE(r.converged);
+    EXPECT_LE(reached, 1e-3 * initial * (1 + 1e-9));
+    EXPECT_NEAR(r.initial_relative_residual, initial / s.b.norm(), 1e-9 * initial / s.b.norm());
+    EXPECT_NEAR(r.relative_residual, reached / s.b.norm(), 1e-6 * reached / s.b.norm());
+
+    auto strict = make_linear_solver(kind, relative);
+    strict->setup(s.a, model.volume);
+    Vector y = start;
+    const SolveReport q = strict->solve(s.b, y);
+    EXPECT_TRUE(q.converged);
+    EXPECT_LT(r.iterations, q.iterations);
+    EXPECT_LE(q.relative_residual, 1e-8);
+  }
+  // Plain PCG (identity preconditioner) reads the same rule.
+  Vector x = start;
+  const SolveReport p = preconditioned_cg(s.a, s.b, x, IdentityPreconditioner(), from_start);
+  EXPECT_TRUE(p.converged);
+  EXPECT_LE((s.b - s.a * x).norm(), 1e-3 * initial * (1 + 1e-9));
+}
+
+TEST(InitialResidualTolerance, TheTighterRelativeRuleWinsWhenTheStartIsPoor) {
+  // From x = 0 the initial residual is ||b||: 0.1 of it is looser than 1e-8 of ||b||, so the
+  // looser (initial residual) rule applies; with 0 the relative rule alone applies.
+  TissueModel model = test::make_box({8, 4, 4}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  SolveSettings off;
+  SolveSettings on = off;
+  on.initial_residual_tolerance = 0.1;
+  Vector x0 = Vector::Zero(s.b.size()), x1 = x0;
+  const SolveReport a = preconditioned_cg(s.a, s.b, x0, IdentityPreconditioner(), off);
+  const SolveReport b = preconditioned_cg(s.a, s.b, x1, IdentityPreconditioner(), on);
+  EXPECT_TRUE(a.converged);
+  EXPECT_TRUE(b.converged);
+  EXPECT_LE(a.relative_residual, 1e-8);
+  EXPECT_LE(b.relative_residual, 0.1);
+  EXPECT_NEAR(b.initial_relative_residual, 1.0, 1e-12);
+  EXPECT_LT(b.iterations, a.iterations);
+}
+
+}  // namespace
+}  // namespace cleave
