@@ -49,13 +49,12 @@ std::string_view Dynamics::solver_name() const { return solver_->name(); }
 
 void Dynamics::rebuild_topology() {
   mass_ = lumped_mass(model_, table_);
-  stiffness_ = make_vertex_block_pattern(model_.volume);
-  system_ = stiffness_;
-  diagonal_.assign(static_cast<std::size_t>(stiffness_.rows()), 0);
-  for (Eigen::Index row = 0; row < stiffness_.rows(); ++row) {
-    const auto* begin = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[row];
-    const auto* end = stiffness_.innerIndexPtr() + stiffness_.outerIndexPtr()[row + 1];
-    diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - stiffness_.innerIndexPtr();
+  system_ = make_vertex_block_pattern(model_.volume);
+  diagonal_.assign(static_cast<std::size_t>(system_.rows()), 0);
+  for (Eigen::Index row = 0; row < system_.rows(); ++row) {
+    const auto* begin = system_.innerIndexPtr() + system_.outerIndexPtr()[row];
+    const auto* end = system_.innerIndexPtr() + system_.outerIndexPtr()[row + 1];
+    diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - system_.innerIndexPtr();
   }
   solver_ready_ = false;  // new pattern: the next step sets the solver up afresh
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
@@ -112,15 +111,22 @@ std::vector<Vec3> Dynamics::displacement_mm() const {
   return out;
 }
 
-Vector Dynamics::internal_forces() const {
+Vector Dynamics::internal_forces(const Vector* velocity) const {
   const LinkedVolume& volume = model_.volume;
   const double h = table_.cell_size_mm;
+  const double beta_k = velocity != nullptr ? settings_.stiffness_damping_s : 0.0;
   std::vector<Vec24> per_cell(static_cast<std::size_t>(volume.cell_count()));
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
     for (CellId c = r.begin(); c != r.end(); ++c) {
       const auto ci = static_cast<std::size_t>(c);
       const Mat3& rot = rotations_[ci];
-      Vec24 local = table_.of_label(volume.cell_label(c)).stiffness * corotated_displacement(cell_displacement(volume, c, u_), rot, h);
+      Vec24 d = corotated_displacement(cell_displacement(volume, c, u_), rot, h);
+      if (beta_k > 0) {
+        // K_R v on the cell = R K^e R^T v_e: the damping force shares K^e and R with the elastic one.
+        const Vec24 ve = cell_displacement(volume, c, *velocity);
+        for (int a = 0; a < kCornerCount; ++a) d.segment<3>(3 * a) += beta_k * (rot.transpose() * ve.segment<3>(3 * a));
+      }
+      Vec24 local = table_.of_label(volume.cell_label(c)).stiffness * d;
       if (!stress_kPa_.empty()) local += table_.stress_divergence * stress_kPa_[ci];
       for (int a = 0; a < kCornerCount; ++a) per_cell[ci].segment<3>(3 * a) = rot * local.segment<3>(3 * a);
     }
@@ -142,23 +148,28 @@ Vector Dynamics::external_forces() const {
   return f;
 }
 
-void Dynamics::assemble_rotated_stiffness() {
+void Dynamics::assemble_system(double c_stiff, double c_mass) {
   const LinkedVolume& volume = model_.volume;
   volume.vertex_cells();
   const auto block = [&](CellId c, int a, int b) -> Mat3 {
     const Mat3& r = rotations_[static_cast<std::size_t>(c)];
-    return r * table_.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
+    return (c_stiff * r) * table_.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
   };
+  double* values = system_.valuePtr();
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, volume.vertex_count()), [&](const tbb::blocked_range<VertexId>& r) {
-    for (VertexId v = r.begin(); v != r.end(); ++v) gather_vertex_rows(volume, v, block, stiffness_);
+    for (VertexId v = r.begin(); v != r.end(); ++v) {
+      gather_vertex_rows(volume, v, block, system_);
+      for (int i = 0; i < 3; ++i) {
+        const auto dof = static_cast<std::size_t>(3 * v + i);
+        values[diagonal_[dof]] += c_mass * mass_[static_cast<Eigen::Index>(dof)];
+      }
+    }
   });
 }
 
 void Dynamics::compute_acceleration() {
-  assemble_rotated_stiffness();
-  Vector net = external_forces() - internal_forces();
+  Vector net = external_forces() - internal_forces(&v_);
   if (settings_.mass_damping_per_s > 0) net -= settings_.mass_damping_per_s * mass_.cwiseProduct(v_);
-  if (settings_.stiffness_damping_s > 0) net -= settings_.stiffness_damping_s * (stiffness_ * v_);
   a_ = net.cwiseQuotient(mass_);
   for (std::size_t i = 0; i < fixed_.size(); ++i)
     if (fixed_[i] != 0) a_[static_cast<Eigen::Index>(i)] = 0.0;
@@ -188,7 +199,6 @@ SolveReport Dynamics::step(double dt) {
   const double beta_k = settings_.stiffness_damping_s;
 
   update_rotations();
-  assemble_rotated_stiffness();
   // HHT: M a(n+1) + w [D v(n+1) + f_int(n+1)] + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - a,
   // with f_int(n+1) ~ f_int(n) + K_R du (R frozen over the step) and v(n+1) = gamma du / (beta dt) + damping_part.
   const double w = 1.0 - settings_.numerical_damping;
@@ -198,19 +208,12 @@ SolveReport Dynamics::step(double dt) {
   // Velocity-like combinations of the old state that enter the increment equation.
   const Vector inertia_part = v_ / (beta * dt) + (0.5 / beta - 1.0) * a_;
   const Vector damping_part = (1.0 - gamma / beta) * v_ + dt * (1.0 - 0.5 * gamma / beta) * a_;
-  Vector rhs = external_forces() - internal_forces() + mass_.cwiseProduct(inertia_part);
   const Vector damped_velocity = w * damping_part + (1.0 - w) * v_;
+  // f_int + beta_k K_R v_damped in one pass over the cells.
+  Vector rhs = external_forces() - internal_forces(&damped_velocity) + mass_.cwiseProduct(inertia_part);
   if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damped_velocity);
-  if (beta_k > 0) rhs -= beta_k * (stiffness_ * damped_velocity);
 
-  {
-    const double* k = stiffness_.valuePtr();
-    double* a = system_.valuePtr();
-    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, stiffness_.nonZeros()), [&](const tbb::blocked_range<Eigen::Index>& r) {
-      for (Eigen::Index i = r.begin(); i != r.end(); ++i) a[i] = c_stiff * k[i];
-    });
-    for (Eigen::Index i = 0; i < system_.rows(); ++i) a[diagonal_[static_cast<std::size_t>(i)]] += c_mass * mass_[i];
-  }
+  assemble_system(c_stiff, c_mass);
   if (any_fixed_) {
     FixedDofs held;
     held.fixed = fixed_;

@@ -97,9 +97,12 @@ class Dynamics {
  private:
   void rebuild_topology();
   void update_rotations();
-  Vector internal_forces() const;
+  /// f_int + beta_k K_R v: the elastic and residual stress forces and, with stiffness damping, the
+  /// damping force of `velocity` from the same per-cell pass (K_R is never assembled for it).
+  Vector internal_forces(const Vector* velocity = nullptr) const;
   Vector external_forces() const;
-  void assemble_rotated_stiffness();
+  /// system_ = c_stiff K_R + c_mass M in one gather (no separate K_R, no scaling pass).
+  void assemble_system(double c_stiff, double c_mass);
   void compute_acceleration();
 
   const TissueModel& model_;
@@ -110,8 +113,7 @@ class Dynamics {
 
   Vector mass_;    ///< lumped, per dof (kg)
   std::vector<std::uint8_t> fixed_;
-  SparseMatrix stiffness_;  ///< K_R, pattern of the current topology
-  SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; same pattern as stiffness_
+  SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; vertex block pattern of the topology
   std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
   bool any_fixed_ = false;
   bool solver_ready_ = false;  ///< set up on the current pattern (later steps only update values)
