@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cctype>
+#include <cmath>
+#include <cstdlib>
 #include <cstdint>
 #include <fmt/format.h>
 #include <sstream>
@@ -38,9 +40,28 @@ bool is_identifier(const std::string& name) {
 }
 
 struct PlyProperty {
+  std::string name;
   std::size_t bytes = 0;        ///< scalar size, or the size of one list item
   std::size_t count_bytes = 0;  ///< size of the list count (0: not a list)
+  bool integer = false;         ///< the scalar (or list item) type is an integer type
 };
+
+/// Whether an ASCII token is a number of the property's type: an integer (optional sign, digits,
+/// at most 18 of them) or a finite real that strtod reads whole.
+bool is_ascii_number(std::string_view token, bool integer) {
+  if (integer) {
+    const std::size_t digits_from = token.empty() || (token[0] != '-' && token[0] != '+') ? 0 : 1;
+    const std::string_view digits = token.substr(digits_from);
+    return !digits.empty() && digits.size() <= 18 && std::all_of(digits.begin(), digits.end(), [](char c) { return c >= '0' && c <= '9'; });
+  }
+  const std::string text(token);
+  char* end = nullptr;
+  const double value = std::strtod(text.c_str(), &end);
+  return !text.empty() && end == text.c_str() + text.size() && std::isfinite(value);
+}
+
+/// The vertex index lists of faces, by the names PLY writers use.
+bool is_vertex_index_list(const PlyProperty& p) { return p.count_bytes > 0 && (p.name == "vertex_indices" || p.name == "vertex_index"); }
 
 struct PlyElement {
   std::string name;
@@ -55,11 +76,22 @@ std::uint64_t list_count(const unsigned char* p, std::size_t bytes, bool big_end
   return v;
 }
 
-/// Walks the ASCII body as assimp reads it, one item per line: every scalar must be there and
+/// Walks the ASCII body as assimp reads it, one item per line: every value must be there and be a
+/// number of its property's type, no line may hold more values than its element's properties,
 /// every list count must be a whole number no larger than the tokens left on its line (assimp
-/// allocated a list of 3444...4 items; found by fuzz_mesh_ply).
+/// allocated a list of 3444...4 items; found by fuzz_mesh_ply), and a face's vertex indices must
+/// name vertices of the file. assimp is left only well-formed bodies: its own error paths on
+/// malformed ones corrupted the heap (an ASan quarantine check failed inside assimp's importer
+/// after 73 min of fuzz_mesh_ply).
 void require_ascii_items_fit(const std::string& data, std::size_t pos, const std::vector<PlyElement>& elements,
                              const std::string& f) {
+  std::uint64_t vertices = 0;
+  for (const PlyElement& e : elements)
+    if (e.name == "vertex") vertices = e.count;
+  const auto not_a_number = [&](const PlyElement& e, std::uint64_t item, std::string_view token) {
+    throw InputError(fmt::format("{}: element '{}' {} has the value '{}'; expected a number", f, e.name, item,
+                                 utf8_prefix(utf8_sanitized(std::string(token)), 40)));
+  };
   for (const PlyElement& e : elements) {
     for (std::uint64_t item = 0; item < e.count; ++item) {
       // the item's line (blank lines skipped)
@@ -84,16 +116,30 @@ void require_ascii_items_fit(const std::string& data, std::size_t pos, const std
         if (token.empty())
           throw InputError(fmt::format("{}: element '{}' {} has fewer values than its {} properties", f, e.name, item,
                                        e.properties.size()));
-        if (p.count_bytes == 0) continue;
+        if (p.count_bytes == 0) {
+          if (!is_ascii_number(token, p.integer)) not_a_number(e, item, token);
+          continue;
+        }
         const bool whole = std::all_of(token.begin(), token.end(), [](char c) { return c >= '0' && c <= '9'; });
         const std::uint64_t n = whole && token.size() <= 9 ? std::stoull(std::string(token)) : 0;
         if (!whole || token.size() > 9 || n > (line.size() - at + 1) / 2)
           throw InputError(fmt::format("{}: element '{}' {} has a list of '{}' items; expected a count its line can hold",
                                        f, e.name, item, utf8_prefix(utf8_sanitized(std::string(token)), 40)));
-        for (std::uint64_t k = 0; k < n; ++k)
-          if (next_token().empty())
+        const bool indices = e.name == "face" && is_vertex_index_list(p);
+        for (std::uint64_t k = 0; k < n; ++k) {
+          const std::string_view value = next_token();
+          if (value.empty())
             throw InputError(fmt::format("{}: element '{}' {} has a list of {} items but fewer values", f, e.name, item, n));
+          if (!is_ascii_number(value, p.integer)) not_a_number(e, item, value);
+          if (indices && (value[0] == '-' || std::stoull(std::string(value[0] == '+' ? value.substr(1) : value)) >= vertices))
+            throw InputError(fmt::format("{}: element 'face' {} refers to vertex {}; the file has {} vertices", f, item,
+                                         utf8_prefix(std::string(value), 40), vertices));
+        }
       }
+      const std::string_view extra = next_token();
+      if (!extra.empty())
+        throw InputError(fmt::format("{}: element '{}' {} has more values than its {} properties (from '{}')", f, e.name,
+                                     item, e.properties.size(), utf8_prefix(utf8_sanitized(std::string(extra)), 40)));
     }
   }
 }
@@ -151,12 +197,15 @@ void require_well_formed_ply(const std::filesystem::path& file) {
       PlyProperty p;
       if (type == "list") {
         std::string count_type, item_type;
-        words >> count_type >> item_type;
+        words >> count_type >> item_type >> p.name;
         p.count_bytes = type_bytes(count_type);
         p.bytes = type_bytes(item_type);
+        p.integer = is_integer_type(item_type);
         if (p.count_bytes == 0 || p.bytes == 0 || !is_integer_type(count_type)) malformed(line);
       } else {
+        words >> p.name;
         p.bytes = type_bytes(type);
+        p.integer = is_integer_type(type);
         if (p.bytes == 0) malformed(line);
       }
       elements.back().properties.push_back(p);

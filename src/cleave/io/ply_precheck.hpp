@@ -10,8 +10,10 @@ namespace cleave {
 /// every line of its header is a well-formed format, comment, obj_info, element or property
 /// line (known scalar types, counts from 0 that fit in the file, elements with properties). For a binary PLY (little- or big-endian) it also walks the declared elements, list
 /// counts included, and refuses data shorter than declared, e.g. "body.ply: the binary data ends
-/// at byte 312 while reading element 'vertex' 2 of 8 (truncated?)". The ASCII body is left to
-/// assimp.
+/// at byte 312 while reading element 'vertex' 2 of 8 (truncated?)". An ASCII body is walked line
+/// by line: every value a number of its property's type, no more values than properties, list
+/// counts that fit, face vertex indices inside the file's vertices, so that assimp only ever
+/// parses well-formed bodies (its error paths corrupted the heap under fuzzing).
 void require_well_formed_ply(const std::filesystem::path& file);
 
 }  // namespace cleave
