@@ -110,7 +110,7 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
   // Decided before anything is allocated for the design: its factors grow faster than the cells.
   std::string design_skipped;
   if (cells > options.design_max_cells)
-    design_skipped = fmt::format("design factor would need ~{:.0f} GB ({} cells is above --design-max-cells {})",
+    design_skipped = fmt::format("design factor would need ~{:.2g} GB ({} cells is above --design-max-cells {})",
                                  design_memory_estimate_gb(cells), cells, options.design_max_cells);
   ScenarioOptions scenario_options;
   scenario_options.cut_segments = kWarmUpSteps + std::max(options.repeat, 1);
