@@ -131,12 +131,21 @@ Vector Dynamics::internal_forces(const Vector* velocity) const {
       for (int a = 0; a < kCornerCount; ++a) per_cell[ci].segment<3>(3 * a) = rot * local.segment<3>(3 * a);
     }
   });
-  Vector f = Vector::Zero(u_.size());
-  for (CellId c = 0; c < volume.cell_count(); ++c) {
-    const auto& corners = volume.cell_vertices(c);
-    for (int a = 0; a < kCornerCount; ++a)
-      f.segment<3>(3 * corners[static_cast<std::size_t>(a)]) += per_cell[static_cast<std::size_t>(c)].segment<3>(3 * a);
-  }
+  // Summed per vertex over its cells (in parallel, without write conflicts).
+  Vector f(u_.size());
+  volume.vertex_cells();
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, volume.vertex_count()), [&](const tbb::blocked_range<VertexId>& r) {
+    for (VertexId v = r.begin(); v != r.end(); ++v) {
+      Vec3 sum = Vec3::Zero();
+      for (const CellId c : volume.vertex_cells()[static_cast<std::size_t>(v)]) {
+        const auto& corners = volume.cell_vertices(c);
+        int a = 0;
+        while (corners[static_cast<std::size_t>(a)] != v) ++a;
+        sum += per_cell[static_cast<std::size_t>(c)].segment<3>(3 * a);
+      }
+      f.segment<3>(3 * v) = sum;
+    }
+  });
   return f;
 }
 
