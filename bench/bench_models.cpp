@@ -37,7 +37,7 @@ std::vector<BenchModel> large_models() { return {tube(84, 102), tube(120, 146)};
 
 std::vector<BenchModel> scaling_models() {
   // Cells grow like n^3 (the tube's length grows with its cross-section: nz = 1.2 n + 1).
-  return {tube(21, 26), tube(30, 37), tube(42, 51), tube(60, 73), tube(84, 102), tube(120, 146)};
+  return {tube(21, 26), tube(30, 37), tube(42, 51), tube(60, 73), tube(84, 102), tube(100, 121), tube(120, 146)};
 }
 
 std::vector<BenchModel> quick_models() {

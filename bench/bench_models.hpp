@@ -34,7 +34,8 @@ struct BenchModel {
 std::vector<BenchModel> table1_models();
 /// `--large`: the tube at 84x84x102 (about 350,000 cells) and 120x120x146 (over 1 million).
 std::vector<BenchModel> large_models();
-/// The tube at increasing resolution, about 5,000 to over 1 million cells (scaling curve).
+/// The tube at increasing resolution, about 5,000 to over 1 million cells (scaling curve; tube-100 is
+/// about 590,000 cells, the largest whose solver stages fit beside other work on a 23 GB machine).
 std::vector<BenchModel> scaling_models();
 /// `--quick`: a small tube and a small abdomen (seconds in total; for smoke tests).
 std::vector<BenchModel> quick_models();

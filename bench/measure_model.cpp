@@ -109,9 +109,11 @@ ModelFigures measure_model(const BenchModel& bench_model, const BenchOptions& op
   const int cells = model.volume.cell_count();
   // Decided before anything is allocated for the design: its factors grow faster than the cells.
   std::string design_skipped;
-  if (cells > options.design_max_cells)
-    design_skipped = fmt::format("design factor would need ~{:.2g} GB ({} cells is above --design-max-cells {})",
-                                 design_memory_estimate_gb(cells), cells, options.design_max_cells);
+  if (cells > options.design_max_cells) {
+    const double gb = design_memory_estimate_gb(cells);
+    design_skipped = fmt::format("design factor would need ~{} GB ({} cells is above --design-max-cells {})",
+                                 gb < 10 ? fmt::format("{:.1f}", gb) : fmt::format("{:.0f}", gb), cells, options.design_max_cells);
+  }
   ScenarioOptions scenario_options;
   scenario_options.cut_segments = kWarmUpSteps + std::max(options.repeat, 1);
   scenario_options.designed_stress = design_skipped.empty();
