@@ -27,6 +27,12 @@ constexpr double kAgreementTolerance = 1e-5;
 // tensor is nearly isotropic (far from every stroke) the principal direction is ill-conditioned
 // and amplifies the CG's 1e-10 residual, so the frames agree to a looser bound.
 constexpr double kFrameAgreementTolerance = 1e-3;
+// cleave's dynamic step stops its solve at 1e-5 of the Newmark predictor's residual
+// (DynamicsSettings::step_tolerance) while CHOLMOD solves exactly and Eigen CG to 1e-8: after the
+// bench's few steps (a cut every step, small displacements) the results differ by 3e-3 to 4.4e-3.
+// The step's accuracy against a 1e-12 solve is asserted over 100 steps in
+// tests/fem/dynamics_step_tolerance_test.cpp; here a real disagreement (a wrong system) is O(1).
+constexpr double kStepAgreementTolerance = 2e-2;
 
 std::vector<nlohmann::json> run_quick_bench(const std::string& arguments = "--quick") {
   const std::string command = std::string(CLEAVE_CLI_PATH) + " bench " + arguments + " --json --quiet";
@@ -91,7 +97,10 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
       ASSERT_TRUE(p.contains("relative_difference"));
       for (const auto& [stage, difference] : p["relative_difference"].items()) {
         SCOPED_TRACE(stage);
-        EXPECT_LT(difference.get<double>(), stage == "vector" ? kFrameAgreementTolerance : kAgreementTolerance);
+        const double tolerance = stage == "vector" ? kFrameAgreementTolerance
+                                 : stage == "step" ? kStepAgreementTolerance
+                                                   : kAgreementTolerance;
+        EXPECT_LT(difference.get<double>(), tolerance);
       }
       EXPECT_TRUE(p["relative_difference"].contains("step"));
       EXPECT_TRUE(p["relative_difference"].contains("preview"));
