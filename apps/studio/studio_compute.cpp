@@ -52,14 +52,7 @@ double ms_since(Clock::time_point t0) { return std::chrono::duration<double, std
 StressDesign design_settings(const CaseFile& case_file) {
   const nlohmann::json* section = case_file.section("design");
   if (!section || !section->is_object()) return StressDesign{};
-  nlohmann::json settings = *section;
-  settings["strokes"] = nlohmann::json::array();
-  // parse_design_json asks for a control point (a case without one would design nothing); the
-  // studio's come from its own edits, so a placeholder stands in and is dropped.
-  settings["control_points"] = {{{"position", {0, 0, 0}}, {"langer_kPa", 0}, {"cross_kPa", 0}}};
-  StressDesign d = parse_design_json(settings, case_file.at("design"));
-  d.control_points.clear();
-  return d;
+  return parse_design_settings_json(*section, case_file.at("design"));
 }
 
 /// Rounds to `step` (mm, kPa): the page does not need more and the messages stay small.

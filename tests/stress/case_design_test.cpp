@@ -37,6 +37,30 @@ std::string parse_error(const std::string& design_json) {
   return "no error";
 }
 
+TEST(CaseDesign, SettingsAloneNeedNoControlPointsAndAreCheckedAlike) {
+  // The studio takes only the settings from its case; its strokes and points come from edits.
+  const JsonPath at{"case.json", "/design"};
+  const StressDesign d = parse_design_settings_json(
+      nlohmann::json::parse(R"({"weights": {"equilibrium": 2}, "equilibrate": false, "equilibrium_support": "none",
+                                "solver": "paper-cg", "snap_tolerance_cells": 3})"),
+      at);
+  EXPECT_TRUE(d.strokes.empty());
+  EXPECT_TRUE(d.control_points.empty());
+  EXPECT_EQ(d.weights.equilibrium, 2.0);
+  EXPECT_EQ(d.equilibration, Equilibration::none);
+  EXPECT_EQ(d.support, EquilibriumSupport::none);
+  EXPECT_EQ(d.solver, EigenvalueSolver::paper_cg);
+  EXPECT_EQ(d.snap_tolerance_cells, 3.0);
+  try {
+    (void)parse_design_settings_json(nlohmann::json::parse(R"({"solver": "fast"})"), at);
+    FAIL() << "expected an InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "case.json: /design/solver is \"fast\"; expected \"default\" or \"paper-cg\"");
+  }
+  EXPECT_EQ(parse_error(R"({"weights": {"equilibrium": 0}})").rfind("case.json: /design/control_points", 0), 0u)
+      << "the full design still needs a control point";
+}
+
 TEST(CaseDesign, ParsesEveryField) {
   const StressDesign d = parse_design_json(nlohmann::json::parse(R"({
       "strokes": [{"points": [[0,0,10],[10,0,10]]}, {"points": [[1,1,5],[2,2,5]], "interior": true}],

@@ -52,22 +52,10 @@ DesignWeights parse_weights(const nlohmann::json& j, const JsonPath& at) {
 
 }  // namespace
 
-StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at) {
+StressDesign parse_design_settings_json(const nlohmann::json& design, const JsonPath& at) {
   json_allow_keys(design, at, {"strokes", "control_points", "weights", "equilibrate", "equilibrium_support", "solver",
                                   "snap_tolerance_cells"});
   StressDesign d;
-  if (const nlohmann::json* strokes = json_find(design, "strokes")) {
-    if (!strokes->is_array()) json_error(at / "strokes", *strokes, "an array of strokes {\"points\": [[x, y, z], ...]}");
-    for (std::size_t i = 0; i < strokes->size(); ++i) d.strokes.push_back(parse_stroke((*strokes)[i], at / "strokes" / i));
-  }
-  const nlohmann::json* control_points = json_find(design, "control_points");
-  const std::string cp_expected =
-      "at least one control point {\"position\": [x, y, z], \"langer_kPa\": .., \"cross_kPa\": ..}; without one the "
-      "stress would silently be zero";
-  if (!control_points) json_missing(at / "control_points", cp_expected);
-  if (!control_points->is_array() || control_points->empty()) json_error(at / "control_points", *control_points, cp_expected);
-  for (std::size_t i = 0; i < control_points->size(); ++i)
-    d.control_points.push_back(parse_control_point((*control_points)[i], at / "control_points" / i));
   if (const nlohmann::json* weights = json_find(design, "weights")) d.weights = parse_weights(*weights, at / "weights");
   if (const nlohmann::json* equilibrate = json_find(design, "equilibrate"))
     d.equilibration = json_bool(*equilibrate, at / "equilibrate") ? Equilibration::growth : Equilibration::none;
@@ -94,6 +82,23 @@ StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at)
   if (const nlohmann::json* tolerance = json_find(design, "snap_tolerance_cells"))
     d.snap_tolerance_cells = json_number_in(*tolerance, at / "snap_tolerance_cells", 1e-3, 1e3,
                                             "a snap tolerance from 0.001 to 1000 cell sizes");
+  return d;
+}
+
+StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at) {
+  StressDesign d = parse_design_settings_json(design, at);
+  if (const nlohmann::json* strokes = json_find(design, "strokes")) {
+    if (!strokes->is_array()) json_error(at / "strokes", *strokes, "an array of strokes {\"points\": [[x, y, z], ...]}");
+    for (std::size_t i = 0; i < strokes->size(); ++i) d.strokes.push_back(parse_stroke((*strokes)[i], at / "strokes" / i));
+  }
+  const nlohmann::json* control_points = json_find(design, "control_points");
+  const std::string cp_expected =
+      "at least one control point {\"position\": [x, y, z], \"langer_kPa\": .., \"cross_kPa\": ..}; without one the "
+      "stress would silently be zero";
+  if (!control_points) json_missing(at / "control_points", cp_expected);
+  if (!control_points->is_array() || control_points->empty()) json_error(at / "control_points", *control_points, cp_expected);
+  for (std::size_t i = 0; i < control_points->size(); ++i)
+    d.control_points.push_back(parse_control_point((*control_points)[i], at / "control_points" / i));
   return d;
 }
 

@@ -35,4 +35,9 @@ std::optional<StressDesign> parse_case_design(const CaseFile& case_file);
 /// The same from the section's JSON value (`at` names where it came from, for messages).
 StressDesign parse_design_json(const nlohmann::json& design, const JsonPath& at);
 
+/// Only the settings of the section (weights, equilibrate, equilibrium_support, solver,
+/// snap_tolerance_cells), with no strokes or control points: for the studio, whose strokes and
+/// points come from its own edits. Keys are checked as in parse_design_json.
+StressDesign parse_design_settings_json(const nlohmann::json& design, const JsonPath& at);
+
 }  // namespace cleave
