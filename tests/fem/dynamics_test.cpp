@@ -52,17 +52,27 @@ StaticResult static_deflection(const TissueModel& model, double load_mN) {
   return solve_static(model, {}, options);
 }
 
-TEST(Dynamics, UndampedNewmarkConservesEnergyOver1000Steps) {
-  const TissueModel model = cantilever_model();
-  const StaticResult bent = static_deflection(model, 0.05);
+/// Exact (CHOLMOD, 1e-12) dynamics of the clamped cantilever, no load.
+DynamicsSettings exact_cantilever_settings(const LinkedVolume& volume) {
   DynamicsSettings settings;
   settings.solver = SolverKind::cholmod;
   settings.solve.relative_tolerance = 1e-12;
-  settings.fixed_vertices = clamped_vertices(model.volume);
+  settings.fixed_vertices = clamped_vertices(volume);
+  return settings;
+}
+
+/// Releases the simulation from the cantilever bent by a 0.05 mN end load, at rest.
+void release_from_bent_shape(const TissueModel& model, Dynamics& sim) {
+  const Vector u0 = flatten(static_deflection(model, 0.05).displacement_mm);
+  sim.set_state(u0, Vector::Zero(u0.size()));
+}
+
+TEST(Dynamics, UndampedNewmarkConservesEnergyOver1000Steps) {
+  const TissueModel model = cantilever_model();
+  DynamicsSettings settings = exact_cantilever_settings(model.volume);
   settings.numerical_damping = 0;  // the average acceleration rule: no numerical damping
   Dynamics sim(model, {}, settings);
-  const Vector u0 = flatten(bent.displacement_mm);
-  sim.set_state(u0, Vector::Zero(u0.size()));  // released from the bent shape
+  release_from_bent_shape(model, sim);
   const double e0 = sim.elastic_energy_uJ();
   ASSERT_GT(e0, 0.0);
   double worst = 0, min_elastic = e0;
@@ -80,10 +90,7 @@ TEST(Dynamics, UndampedNewmarkConservesEnergyOver1000Steps) {
 TEST(Dynamics, DampedMotionComesToRestAtTheStaticSolution) {
   const TissueModel model = cantilever_model();
   const StaticResult target = static_deflection(model, 0.02);
-  DynamicsSettings settings;
-  settings.solver = SolverKind::cholmod;
-  settings.solve.relative_tolerance = 1e-12;
-  settings.fixed_vertices = clamped_vertices(model.volume);
+  DynamicsSettings settings = exact_cantilever_settings(model.volume);
   settings.external_force_mN = end_load(model.volume, 0.02);
   settings.mass_damping_per_s = 200.0;    // near-critical for the first mode (omega ~ 250 / s)
   settings.stiffness_damping_s = 1e-4;
@@ -102,14 +109,8 @@ TEST(Dynamics, DefaultNumericalDampingBarelyTouchesTheResolvedOscillation) {
   // default a = 0.2 is second-order accurate there, so after 100 ms (4 periods) more than 90 % of
   // the energy is left (measured 94.8 %); it does decay (what the damping is for).
   const TissueModel model = cantilever_model();
-  const StaticResult bent = static_deflection(model, 0.05);
-  DynamicsSettings settings;
-  settings.solver = SolverKind::cholmod;
-  settings.solve.relative_tolerance = 1e-12;
-  settings.fixed_vertices = clamped_vertices(model.volume);
-  Dynamics sim(model, {}, settings);
-  const Vector u0 = flatten(bent.displacement_mm);
-  sim.set_state(u0, Vector::Zero(u0.size()));
+  Dynamics sim(model, {}, exact_cantilever_settings(model.volume));
+  release_from_bent_shape(model, sim);
   const double e0 = sim.elastic_energy_uJ();
   for (int i = 0; i < 100; ++i) sim.step(kTimeStep_s);
   const double e = sim.kinetic_energy_uJ() + sim.elastic_energy_uJ();
