@@ -127,6 +127,35 @@ TEST(FuzzRegressions, MalformedAsciiPlyBodiesNeverReachAssimp) {
   EXPECT_EQ(read_surface_mesh(tmp / "ok.ply", 1.0).triangles.size(), 1u);
 }
 
+// fuzz_mesh_ply (third leg, on the code with the ASCII body walk): the same heap corruption
+// inside assimp after 15 min; the last input had no format line and element lines with trailing
+// garbage ("element fac 0.0ace 13"), which the header check let through. Header lines are now
+// exact: one format line before the elements, whole element counts, nothing after a line's fields.
+TEST(FuzzRegressions, PlyHeaderLinesMustBeExact) {
+  const auto file = kRegressions / "mesh_ply" / "header_garbage_heap_corruption.ply";
+  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+            file.string() + ": malformed PLY header line 'element fac 0.0ace 13'");
+  test::TempFolder tmp;
+  const auto error_for = [&](const std::string& header) {
+    test::write_bytes(tmp / "h.ply", header + "end_header\n0 0 0\n");
+    return error_of([&] { (void)read_surface_mesh(tmp / "h.ply", 1.0); });
+  };
+  const std::string h = (tmp / "h.ply").string();
+  EXPECT_EQ(error_for("ply\nelement vertex 1\nproperty float x\n"),
+            h + ": the PLY header has no format line; expected 'format ascii 1.0', 'format binary_little_endian 1.0' or "
+                "'format binary_big_endian 1.0' before the elements");
+  EXPECT_EQ(error_for("ply\nformat ascii 1.0\nformat ascii 1.0\nelement vertex 1\nproperty float x\n"),
+            h + ": malformed PLY header line 'format ascii 1.0'");
+  EXPECT_EQ(error_for("ply\nformat ascii 1.0\nelement vertex 1 2\nproperty float x\n"),
+            h + ": malformed PLY header line 'element vertex 1 2'");
+  EXPECT_EQ(error_for("ply\nformat ascii 1.0\nelement vertex 1.5\nproperty float x\n"),
+            h + ": malformed PLY header line 'element vertex 1.5'");
+  EXPECT_EQ(error_for("ply\nformat ascii 1.0\nelement vertex 1\nproperty float\n"),
+            h + ": malformed PLY header line 'property float'");
+  EXPECT_EQ(error_for("ply\nformat ascii 1.0\nelement vertex 1\nproperty float x y\n"),
+            h + ": malformed PLY header line 'property float x y'");
+}
+
 // fuzz_mesh_ply: a binary PLY header without end_header made assimp read past its buffer.
 TEST(FuzzRegressions, PlyWithoutEndHeaderIsRefusedBeforeAssimp) {
   const auto file = kRegressions / "mesh_ply" / "binary_without_end_header.ply";

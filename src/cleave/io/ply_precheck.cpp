@@ -167,8 +167,14 @@ void require_well_formed_ply(const std::filesystem::path& file) {
   std::size_t pos = data.find('\n', header_end);
   pos = pos == std::string::npos ? data.size() : pos + 1;
   std::istringstream header(data.substr(0, header_end));
-  bool binary = false, big_endian = false;
+  bool binary = false, big_endian = false, format_seen = false;
   std::vector<PlyElement> elements;
+  // Each line must be exactly what its keyword allows: nothing missing, nothing after it (assimp's
+  // error paths on such headers corrupted the heap under fuzzing).
+  const auto nothing_after = [](std::istringstream& words) {
+    std::string extra;
+    return !(words >> extra);
+  };
   for (std::string line; std::getline(header, line);) {
     std::istringstream words(line);
     std::string keyword;
@@ -179,16 +185,20 @@ void require_well_formed_ply(const std::filesystem::path& file) {
       std::string format, version;
       words >> format >> version;
       // assimp reads an unknown format as ASCII and misparses the rest (a 64 GB allocation found by fuzz_mesh_ply)
-      if ((format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") || version != "1.0")
+      if ((format != "ascii" && format != "binary_little_endian" && format != "binary_big_endian") || version != "1.0" ||
+          format_seen || !elements.empty() || !nothing_after(words))
         malformed(line);
+      format_seen = true;
       binary = format == "binary_little_endian" || format == "binary_big_endian";
       big_endian = format == "binary_big_endian";
     } else if (keyword == "element") {
       PlyElement e;
-      long long count = -1;
+      std::string count;
       words >> e.name >> count;
-      if (words.fail() || count < 0 || !is_identifier(e.name)) malformed(line);
-      e.count = static_cast<std::uint64_t>(count);
+      const bool whole = !count.empty() && count.size() <= 18 &&
+                         std::all_of(count.begin(), count.end(), [](char c) { return c >= '0' && c <= '9'; });
+      if (!whole || !is_identifier(e.name) || !nothing_after(words)) malformed(line);
+      e.count = std::stoull(count);
       elements.push_back(e);
     } else if (keyword == "property") {
       if (elements.empty()) malformed(line);
@@ -208,11 +218,16 @@ void require_well_formed_ply(const std::filesystem::path& file) {
         p.integer = is_integer_type(type);
         if (p.bytes == 0) malformed(line);
       }
+      if (p.name.empty() || !nothing_after(words)) malformed(line);
       elements.back().properties.push_back(p);
     } else {
       malformed(line);  // assimp loops on some unknown lines (a hang found by fuzz_mesh_ply)
     }
   }
+  if (!format_seen)
+    throw InputError(fmt::format("{}: the PLY header has no format line; expected 'format ascii 1.0', "
+                                 "'format binary_little_endian 1.0' or 'format binary_big_endian 1.0' before the elements",
+                                 f));
   // Every item takes at least one byte in either encoding: a count beyond the file's size is a
   // corrupt header, and assimp would loop over it (an item without properties takes none).
   std::uint64_t items = 0;
