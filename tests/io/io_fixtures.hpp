@@ -50,7 +50,7 @@ inline std::string read_bytes(const std::filesystem::path& file) {
 
 /// Icosahedron subdivided `levels` times, vertices projected onto the sphere (centre, radius).
 /// Level 4: 2562 vertices, 5120 triangles; its volume is 0.4% below the sphere's.
-inline SurfaceMesh icosphere(const Vec3& centre, double radius, int levels) {
+inline TriangleMesh icosphere(const Vec3& centre, double radius, int levels) {
   const double t = (1.0 + std::sqrt(5.0)) / 2.0;
   std::vector<Vec3> v = {{-1, t, 0}, {1, t, 0}, {-1, -t, 0}, {1, -t, 0}, {0, -1, t}, {0, 1, t},
                          {0, -1, -t}, {0, 1, -t}, {t, 0, -1}, {t, 0, 1}, {-t, 0, -1}, {-t, 0, 1}};
@@ -78,13 +78,13 @@ inline SurfaceMesh icosphere(const Vec3& centre, double radius, int levels) {
     }
     f = std::move(next);
   }
-  SurfaceMesh mesh;
+  TriangleMesh mesh;
   for (const auto& p : v) mesh.vertices_mm.push_back(centre + radius * p);
   mesh.triangles = f;
   return mesh;
 }
 
-inline std::string to_obj(const SurfaceMesh& m) {
+inline std::string to_obj(const TriangleMesh& m) {
   std::string s = "# icosphere\n";
   for (const auto& p : m.vertices_mm) s += "v " + std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
   for (const auto& t : m.triangles)
@@ -92,7 +92,7 @@ inline std::string to_obj(const SurfaceMesh& m) {
   return s;
 }
 
-inline std::string to_off(const SurfaceMesh& m) {
+inline std::string to_off(const TriangleMesh& m) {
   std::string s = "OFF\n" + std::to_string(m.vertices_mm.size()) + " " + std::to_string(m.triangles.size()) + " 0\n";
   for (const auto& p : m.vertices_mm) s += std::to_string(p.x()) + " " + std::to_string(p.y()) + " " + std::to_string(p.z()) + "\n";
   for (const auto& t : m.triangles)
@@ -100,7 +100,7 @@ inline std::string to_off(const SurfaceMesh& m) {
   return s;
 }
 
-inline std::string to_ascii_ply(const SurfaceMesh& m) {
+inline std::string to_ascii_ply(const TriangleMesh& m) {
   std::string s = "ply\nformat ascii 1.0\nelement vertex " + std::to_string(m.vertices_mm.size()) +
                   "\nproperty float x\nproperty float y\nproperty float z\nelement face " +
                   std::to_string(m.triangles.size()) + "\nproperty list uchar int vertex_indices\nend_header\n";
@@ -111,7 +111,7 @@ inline std::string to_ascii_ply(const SurfaceMesh& m) {
 }
 
 /// Binary STL (little-endian floats), the common form of STL files.
-inline std::string to_binary_stl(const SurfaceMesh& m) {
+inline std::string to_binary_stl(const TriangleMesh& m) {
   std::string s(80, ' ');
   auto put_u32 = [&](std::uint32_t x) { s.append(reinterpret_cast<const char*>(&x), 4); };
   auto put_f32 = [&](double x) {

@@ -38,18 +38,18 @@ std::string message_of(const std::function<void()>& f) {
 
 struct MeshFormat {
   std::string extension;
-  std::string (*write)(const SurfaceMesh&);
+  std::string (*write)(const TriangleMesh&);
 };
 
 class SphereInEachFormat : public ::testing::TestWithParam<MeshFormat> {};
 
 TEST_P(SphereInEachFormat, VolumeWithinTwoPercentAtTwentyCellsPerDiameter) {
   TempFolder tmp;
-  const SurfaceMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
+  const TriangleMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
   const auto file = tmp / ("sphere" + GetParam().extension);
   test::write_bytes(file, GetParam().write(sphere));
 
-  const SurfaceMesh read = read_surface_mesh(file, 1.0);
+  const TriangleMesh read = read_surface_mesh(file, 1.0);
   EXPECT_EQ(read.triangles.size(), 5120u);
   EXPECT_EQ(read.vertices_mm.size(), 2562u) << "identical vertices are merged";
 
@@ -69,7 +69,7 @@ INSTANTIATE_TEST_SUITE_P(Formats, SphereInEachFormat,
                          [](const auto& p) { return p.param.extension.substr(1); });
 
 TEST(MeshVoxelizer, CornerDistancesAreTheSignedDistanceToTheSurface) {
-  const SurfaceMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
+  const TriangleMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
   const double h = 2 * kRadiusMm / kCellsPerDiameter;
   const LabelVolume v = voxelize_surface_mesh(sphere, {h, "sphere", {}});
   ASSERT_TRUE(v.has_distance());
@@ -92,7 +92,7 @@ TEST(MeshVoxelizer, CornerDistancesAreTheSignedDistanceToTheSurface) {
 }
 
 TEST(MeshVoxelizer, ToleratesSmallHoles) {
-  SurfaceMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
+  TriangleMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
   // Remove 6 triangles spread over the surface (each about 2.5 mm across, half a cell).
   for (size_t k = 0; k < 6; ++k) sphere.triangles.erase(sphere.triangles.begin() + static_cast<long>(800 * k + 17));
   const LabelVolume v = voxelize_surface_mesh(sphere, {2 * kRadiusMm / kCellsPerDiameter, "holey sphere", {}});
@@ -100,7 +100,7 @@ TEST(MeshVoxelizer, ToleratesSmallHoles) {
 }
 
 TEST(MeshVoxelizer, ToleratesInconsistentOrientationAndDuplicatedTriangles) {
-  SurfaceMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
+  TriangleMesh sphere = test::icosphere(kCentreMm, kRadiusMm, 4);
   for (size_t t = 0; t < sphere.triangles.size(); t += 3) std::swap(sphere.triangles[t][0], sphere.triangles[t][1]);
   sphere.triangles.push_back(sphere.triangles[5]);  // a non-manifold edge
   const LabelVolume v = voxelize_surface_mesh(sphere, {2 * kRadiusMm / kCellsPerDiameter, "flipped sphere", {}});
@@ -222,7 +222,7 @@ TEST(BadMesh, NanCoordinateInOff) {
 TEST(BadMesh, NanCoordinate) {
   TempFolder tmp;
   const auto file = tmp / "nan.stl";
-  SurfaceMesh m = test::icosphere({0, 0, 0}, 1.0, 1);
+  TriangleMesh m = test::icosphere({0, 0, 0}, 1.0, 1);
   m.vertices_mm[3].y() = std::numeric_limits<double>::quiet_NaN();
   test::write_bytes(file, test::to_binary_stl(m));
   const std::string message = message_of([&] { read_surface_mesh(file, 1.0); });
@@ -243,7 +243,7 @@ TEST(BadMesh, FlatOpenSquareEnclosesNothing) {
 }
 
 TEST(BadMesh, AllVerticesCoincide) {
-  SurfaceMesh m;
+  TriangleMesh m;
   m.vertices_mm = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
   m.triangles = {{0, 1, 2}};
   EXPECT_EQ(message_of([&] { voxelize_surface_mesh(m, {std::nullopt, "point.obj", {}}); }),

@@ -141,17 +141,19 @@ TEST(MessageHandler, ErrorsAreOneLineAndLeaveTheSessionUnchanged) {
 TEST(FieldWorker, NewerJobsSupersedeOlderOnesAndOnlyCurrentResultsArePublished) {
   std::mutex m;
   std::vector<std::uint64_t> published;
-  std::atomic<bool> release{false};
+  std::atomic<bool> release{false}, started{false};
   FieldWorker worker([&](FieldWorker::Result r) {
     std::lock_guard lock(m);
     published.push_back(r.generation);
   });
   // Job 1 blocks until released; jobs 2..9 queue up behind it and replace each other.
   worker.submit([&](const FieldWorker::Context& ctx) {
+    started = true;
     while (!release.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
     return json{{"type", "result"}, {"g", ctx.generation}};
   });
-  std::this_thread::sleep_for(std::chrono::milliseconds(20));
+  // wait until job 1 is in flight (a fixed sleep failed on a loaded machine)
+  while (!started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
   std::uint64_t last = 0;
   for (int i = 0; i < 8; ++i)
     last = worker.submit([](const FieldWorker::Context& ctx) { return json{{"type", "result"}, {"g", ctx.generation}}; });

@@ -68,7 +68,7 @@ bool boundary_follows_surface(const LabelVolume& volume, const std::vector<float
 
 }  // namespace
 
-LabelVolume voxelize_surface_mesh(const SurfaceMesh& mesh, const MeshVoxelizeOptions& options) {
+LabelVolume voxelize_surface_mesh(const TriangleMesh& mesh, const MeshVoxelizeOptions& options) {
   const std::string& f = options.source;
   if (mesh.vertices_mm.empty() || mesh.triangles.empty())
     throw InputError(fmt::format("{}: the mesh has no triangles", f));

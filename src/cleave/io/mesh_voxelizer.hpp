@@ -29,6 +29,6 @@ inline constexpr int kDefaultMeshCellsAlongLargestExtent = 64;
 /// not fit in memory (before voxelizing), or a surface that encloses nothing: no cell centre half
 /// a cell deep inside, or an inside region whose boundary mostly lies away from the triangles
 /// (open, flat or degenerate surfaces: "encloses no volume").
-LabelVolume voxelize_surface_mesh(const SurfaceMesh& mesh, const MeshVoxelizeOptions& options);
+LabelVolume voxelize_surface_mesh(const TriangleMesh& mesh, const MeshVoxelizeOptions& options);
 
 }  // namespace cleave

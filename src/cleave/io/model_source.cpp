@@ -32,7 +32,7 @@ LabelVolume load_mesh(const std::string& name, const ModelSourceOptions& options
   if (!options.labels.empty() || options.threshold)
     throw InputError(fmt::format("{}: labels and thresholds select parts of volumes; a mesh has none", name));
   report(options.progress, "reading " + name, 0.0);
-  const SurfaceMesh mesh = read_surface_mesh(name, options.mesh_scale);
+  const TriangleMesh mesh = read_surface_mesh(name, options.mesh_scale);
   return voxelize_surface_mesh(mesh, {options.cell_size_mm, name, options.progress});
 }
 

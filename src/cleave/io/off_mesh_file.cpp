@@ -51,7 +51,7 @@ T parse(const OffLines& lines, const std::string& token, const char* what) {
 
 }  // namespace
 
-SurfaceMesh read_off_mesh(const std::filesystem::path& file, double scale) {
+TriangleMesh read_off_mesh(const std::filesystem::path& file, double scale) {
   OffLines lines(file);
   std::vector<std::string> tokens = lines.next("the OFF header");
   const std::string& first = tokens.front();
@@ -70,7 +70,7 @@ SurfaceMesh read_off_mesh(const std::filesystem::path& file, double scale) {
   if (vertex_count < 0 || face_count < 0 || vertex_count > kMaxElements || face_count > kMaxElements)
     throw InputError(fmt::format("{}: line {}: counts {} vertices and {} faces; expected 0 to 2^30 each",
                                  lines.file(), lines.line(), vertex_count, face_count));
-  SurfaceMesh mesh;
+  TriangleMesh mesh;
   for (long long v = 0; v < vertex_count; ++v) {
     tokens = lines.next("a vertex");
     if (tokens.size() < 3)

@@ -13,6 +13,6 @@ namespace cleave {
 /// '#' starts a comment. Coordinates are multiplied by `scale`.
 /// Throws InputError naming the file and the line: truncated file, a malformed number, a face
 /// index out of range, a non-finite coordinate.
-SurfaceMesh read_off_mesh(const std::filesystem::path& file, double scale);
+TriangleMesh read_off_mesh(const std::filesystem::path& file, double scale);
 
 }  // namespace cleave

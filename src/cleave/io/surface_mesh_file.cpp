@@ -9,7 +9,7 @@
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/off_mesh_file.hpp"
-#include "cleave/io/ply_precheck.hpp"
+#include "cleave/io/ply_mesh_file.hpp"
 
 namespace cleave {
 namespace {
@@ -21,7 +21,7 @@ namespace {
 
 }  // namespace
 
-SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
+TriangleMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
   const std::string f = file.string();
   if (!(scale > 0) || !std::isfinite(scale))
     throw InputError(fmt::format("{}: mesh scale {}; expected a positive finite factor", f, scale));
@@ -30,16 +30,16 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
 
   std::string extension = file.extension().string();
   for (char& c : extension) c = static_cast<char>(std::tolower(static_cast<unsigned char>(c)));
-  if (extension == ".off") {
-    SurfaceMesh mesh = read_off_mesh(file, scale);
+  // OFF and PLY are parsed by cleave: assimp's OFF importer aborts on truncated files and its PLY
+  // importer corrupted the heap on malformed ones (off_mesh_file.hpp, ply_mesh_file.hpp).
+  if (extension == ".off" || extension == ".ply") {
+    TriangleMesh mesh = extension == ".off" ? read_off_mesh(file, scale) : read_ply_mesh(file, scale);
     if (mesh.triangles.empty()) throw InputError(fmt::format("{}: the mesh has no triangles", f));
     for (const Vec3& p : mesh.vertices_mm)
       if (!p.allFinite())
         throw InputError(fmt::format("{}: mesh scale {} makes coordinates overflow; expected a smaller scale", f, scale));
     return mesh;
   }
-
-  if (extension == ".ply") require_well_formed_ply(file);  // assimp reads past a truncated one
 
   Assimp::Importer importer;
   // Keep points and lines out (only triangles bound a volume); no normals or UVs are needed.
@@ -68,7 +68,7 @@ SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale) {
                                                       aiProcess_JoinIdenticalVertices | aiProcess_PreTransformVertices |
                                                       aiProcess_SortByPType);
   if (scene == nullptr) fail_import(f, importer.GetErrorString());
-  SurfaceMesh mesh;
+  TriangleMesh mesh;
   for (unsigned m = 0; m < scene->mNumMeshes; ++m) {
     const aiMesh& part = *scene->mMeshes[m];
     const size_t base = mesh.vertices_mm.size();

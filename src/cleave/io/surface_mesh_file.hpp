@@ -1,6 +1,7 @@
 #pragma once
-// Reading a triangle surface mesh from OBJ, STL (ASCII or binary), PLY (ASCII or binary) with
-// assimp, or OFF with cleave's own parser (off_mesh_file.hpp; assimp aborts on truncated OFF).
+// Reading a triangle surface mesh from OBJ or STL (ASCII or binary) with assimp, or from OFF and
+// PLY (ASCII, binary little- or big-endian) with cleave's own parsers (off_mesh_file.hpp,
+// ply_mesh_file.hpp: assimp aborts on truncated OFF and corrupted the heap on malformed PLY).
 #include <array>
 #include <filesystem>
 #include <vector>
@@ -11,7 +12,7 @@ namespace cleave {
 
 /// An indexed triangle mesh. Orientation and closedness are not required here (the voxelizer
 /// decides inside from the whole surface).
-struct SurfaceMesh {
+struct TriangleMesh {
   std::vector<Vec3> vertices_mm;               ///< positions (mm, already scaled)
   std::vector<std::array<int, 3>> triangles;   ///< vertex indices; polygons are triangulated
 };
@@ -22,6 +23,6 @@ struct SurfaceMesh {
 /// Throws InputError naming the file and the problem: missing file, a file assimp cannot parse
 /// (malformed or truncated), no triangles, a non-finite coordinate (e.g. "vertex 3 is (nan, 0, 1)"),
 /// or a scale that is not positive and finite.
-SurfaceMesh read_surface_mesh(const std::filesystem::path& file, double scale);
+TriangleMesh read_surface_mesh(const std::filesystem::path& file, double scale);
 
 }  // namespace cleave
