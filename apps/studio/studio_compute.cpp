@@ -254,6 +254,7 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
     incisions_only.incisions = requests.incisions;
     plan_ = plan_cuts(*body_surface_, incisions_only);
   }
+  preview_statics_.reset();  // it refers to the model being replaced
   preview_model_ = std::make_shared<TissueModel>(session_.model());
   apply_cut_plan(preview_model_->volume, plan_);
   preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
@@ -353,10 +354,13 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     }
     t = Clock::now();
     report(ctx.progress, "opening the incisions", 0.7);
-    StaticOptions options;
-    options.solver = SolverKind::cholmod;
-    options.fixed_vertices = held_cut_;
-    const StaticResult r = solve_static(*preview_model_, stress_kPa_, options);
+    if (!preview_statics_) {
+      StaticOptions options;
+      options.solver = SolverKind::cholmod;
+      options.fixed_vertices = held_cut_;
+      preview_statics_ = std::make_unique<StaticSolver>(*preview_model_, options);
+    }
+    const StaticResult r = preview_statics_->solve(stress_kPa_);
     displacement_mm_ = r.displacement_mm;
     timings["incisions"] = ms_since(t);
   }

@@ -11,6 +11,7 @@
 
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/cut/cut_plan.hpp"
+#include "cleave/fem/static_solver.hpp"
 #include "cleave/io/case_mechanics.hpp"
 #include "cleave/solve/linear_solver.hpp"
 #include "cleave/stress/line_field_interpolation.hpp"
@@ -74,6 +75,9 @@ class StudioCompute {
   std::shared_ptr<TissueModel> preview_model_;        ///< the model cut by the preview and the user's cuts
   std::unique_ptr<RenderSurface> preview_surface_;
   std::unique_ptr<BodySurface> cut_body_surface_;     ///< of preview_model_, for the measurements
+  /// Statics of preview_model_ (stiffness, supports and CHOLMOD factor kept while the cuts do not
+  /// change, so a design edit re-solves without refactoring); reset before preview_model_ changes.
+  std::unique_ptr<StaticSolver> preview_statics_;
 
   const StudioSession& session_;
   std::function<void(std::string)> send_;

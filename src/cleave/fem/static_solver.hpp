@@ -1,0 +1,47 @@
+#pragma once
+// Statics for many loads on one model: the stiffness is assembled, the supports chosen and the
+// linear solver set up (a CHOLMOD factor, a multigrid hierarchy) once; each solve then costs one
+// right-hand side. The studio keeps one per cut state, so a design edit that changes only the
+// residual stress re-solves without refactoring.
+//
+//   StaticSolver statics(cut_model, options);          // assemble + factor once
+//   StaticResult a = statics.solve(stress_kPa);        // K u = f - T sigma
+//   StaticResult b = statics.solve(other_stress_kPa);  // same factor
+//
+// The model must outlive the solver and keep its topology (no cut) while the solver is used.
+#include <memory>
+#include <span>
+
+#include "cleave/fem/fixed_dofs.hpp"
+#include "cleave/fem/rigid_supports.hpp"
+#include "cleave/fem/solve_static.hpp"
+
+namespace cleave {
+
+class StaticSolver {
+ public:
+  /// Assembles the model's stiffness. Throws InputError for a mismatched external force.
+  StaticSolver(const TissueModel& model, const StaticOptions& options);
+  /// With an assembled stiffness of the model's current topology (see assemble_stiffness.hpp).
+  StaticSolver(const TissueModel& model, SparseMatrix stiffness, const StaticOptions& options);
+
+  /// Solves K u = f - T sigma (f: the options' external force) as solve_static does; the solver
+  /// is set up at the first loaded solve and kept. Throws as solve_static.
+  StaticResult solve(std::span<const Vec6> residual_stress_kPa);
+
+  int solves() const { return solves_; }  ///< loaded solves done
+  bool set_up() const { return set_up_; }
+
+ private:
+  const TissueModel& model_;
+  StaticOptions options_;
+  SparseMatrix eliminated_;  ///< K with the held dofs' rows and columns replaced by identity
+  Vector fixed_load_;        ///< the right-hand side that elimination makes of a zero load
+  FixedDofs fixed_;
+  RigidSupportReport supports_;
+  std::unique_ptr<LinearSolver> solver_;
+  bool set_up_ = false;
+  int solves_ = 0;
+};
+
+}  // namespace cleave
