@@ -86,6 +86,23 @@ void refresh_block_values(const SparseMatrix& a, BlockSparseMatrix<Scalar>& b) {
   for_each_block_row(b.block_rows(), [&](Eigen::Index v) { fill_block_row(a, v, b); });
 }
 
+void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a) {
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  double* values = a.valuePtr();
+  for_each_block_row(b.block_rows(), [&](Eigen::Index v) {
+    const auto first = b.column.begin() + b.row_start[static_cast<std::size_t>(v)];
+    const auto last = b.column.begin() + b.row_start[static_cast<std::size_t>(v) + 1];
+    for (int i = 0; i < 3; ++i)
+      for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) {
+        const auto block = std::lower_bound(first, last, static_cast<std::int32_t>(inner[k] / 3));
+        if (block == last || *block != inner[k] / 3) continue;
+        values[k] = b.values[9 * static_cast<std::size_t>(block - b.column.begin()) + 3 * static_cast<std::size_t>(i) +
+                             static_cast<std::size_t>(inner[k] % 3)];
+      }
+  });
+}
+
 namespace {
 
 /// sum over the blocks of row v of A_vw x_w.

@@ -41,6 +41,10 @@ BlockSparseMatrix<Scalar> to_block_sparse(const SparseMatrix& a);
 template <typename Scalar>
 void refresh_block_values(const SparseMatrix& a, BlockSparseMatrix<Scalar>& b);
 
+/// The inverse of refresh_block_values: writes b's values into a, whose pattern b was built from
+/// (to_block_sparse(a)); entries of b outside a's pattern are not written.
+void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a);
+
 template <typename Scalar>
 void multiply(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatrix<Scalar>::VectorType& x,
               typename BlockSparseMatrix<Scalar>::VectorType& y);

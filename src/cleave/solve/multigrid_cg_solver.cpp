@@ -17,6 +17,10 @@ namespace {
 /// incised abdomen, with free plugs on 3-2-1 supports, then needs about 17 more).
 constexpr int kSinglePrecisionMaxIterations = 40;
 
+/// Iterations a stale solve may take beyond MultigridOptions::stale_solve_rebuild_factor times
+/// the first solve's before its levels are rebuilt.
+constexpr int kStaleExtraIterations = 10;
+
 class MultigridCgSolver final : public LinearSolver {
  public:
   MultigridCgSolver(const SolveSettings& settings, const MultigridOptions& options) : settings_(settings), options_(options) {}
@@ -25,11 +29,8 @@ class MultigridCgSolver final : public LinearSolver {
     preconditioner_ = MultigridPreconditioner();  // drops the reference to the old matrix first
     a_ = a;
     a_.makeCompressed();
-    preconditioner_ = build_multigrid(a_, topology, options_);
     a_blocks_ = to_block_sparse<double>(a_);
-    stale_updates_ = 0;
-    baseline_iterations_ = -1;
-    rebuild_requested_ = false;
+    build(topology);
   }
 
   void update_values(const SparseMatrix& a, const LinkedVolume& topology) override {
@@ -44,40 +45,82 @@ class MultigridCgSolver final : public LinearSolver {
     refresh_block_values(a, a_blocks_);
     preconditioner_.refresh_fine_level(a_blocks_);
     ++stale_updates_;
+    topology_ = &topology;
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
     if (b.size() != a_.rows())
       throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));
-    SolveReport report;
-    if (preconditioner_.precision() == CyclePrecision::single_precision) {
-      SolveSettings attempt = settings_;
-      attempt.max_iterations = std::min(settings_.max_iterations, kSinglePrecisionMaxIterations);
-      report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
-      if (!report.converged && report.iterations < settings_.max_iterations) {
-        // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
-        preconditioner_.use_double_precision(a_blocks_);
-        const int spent = report.iterations;
-        const double initial = report.initial_relative_residual;
-        attempt.max_iterations = settings_.max_iterations - spent;
-        // The initial-residual rule refers to the caller's initial guess, not to where float left x.
-        attempt.relative_tolerance = std::max(settings_.relative_tolerance, settings_.initial_residual_tolerance * initial);
-        attempt.initial_residual_tolerance = 0;
-        report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
-        report.iterations += spent;
-        report.initial_relative_residual = initial;
-      }
-    } else {
-      report = preconditioned_cg(a_blocks_, b, x, preconditioner_, settings_);
-    }
-    if (baseline_iterations_ < 0) baseline_iterations_ = report.iterations;
-    else if (report.iterations > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
+    if (stale_updates_ == 0 || baseline_iterations_ < 0 || options_.stale_solve_rebuild_factor <= 0 || topology_ == nullptr)
+      return track(solve_with(b, x, settings_));
+    SolveSettings capped = settings_;
+    capped.max_iterations = std::min(
+        settings_.max_iterations,
+        static_cast<int>(options_.stale_solve_rebuild_factor * baseline_iterations_) + kStaleExtraIterations);
+    const SolveReport stale = solve_with(b, x, capped);
+    if (stale.converged || stale.iterations >= settings_.max_iterations) return track(stale);
+    // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
+    preconditioner_ = MultigridPreconditioner();
+    copy_block_values(a_blocks_, a_);
+    build(*topology_);
+    SolveSettings rest = continuation(stale, settings_.max_iterations - stale.iterations);
+    SolveReport report = solve_with(b, x, rest);
+    baseline_iterations_ = report.iterations;
+    report.iterations += stale.iterations;
+    report.initial_relative_residual = stale.initial_relative_residual;
     return report;
   }
 
   std::string_view name() const override { return "multigrid"; }
 
  private:
+  void build(const LinkedVolume& topology) {
+    preconditioner_ = build_multigrid(a_, topology, options_);
+    topology_ = &topology;
+    stale_updates_ = 0;
+    baseline_iterations_ = -1;
+    rebuild_requested_ = false;
+  }
+
+  /// Settings to go on from where `first` left x: the initial-residual rule refers to the
+  /// caller's initial guess, so it becomes an absolute tolerance.
+  SolveSettings continuation(const SolveReport& first, int iterations_left) const {
+    SolveSettings rest = settings_;
+    rest.max_iterations = iterations_left;
+    rest.relative_tolerance = std::max(settings_.relative_tolerance, settings_.initial_residual_tolerance * first.initial_relative_residual);
+    rest.initial_residual_tolerance = 0;
+    return rest;
+  }
+
+  /// CG with the cycle: single precision first, the double cycle if float rounding stalls it.
+  SolveReport solve_with(const Vector& b, Vector& x, const SolveSettings& settings) {
+    if (preconditioner_.precision() != CyclePrecision::single_precision)
+      return preconditioned_cg(a_blocks_, b, x, preconditioner_, settings);
+    SolveSettings attempt = settings;
+    attempt.max_iterations = std::min(settings.max_iterations, kSinglePrecisionMaxIterations);
+    SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+    if (report.converged || report.iterations >= settings.max_iterations) return report;
+    // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
+    preconditioner_.use_double_precision(a_blocks_);
+    const int spent = report.iterations;
+    const double initial = report.initial_relative_residual;
+    attempt.max_iterations = settings.max_iterations - spent;
+    attempt.relative_tolerance = std::max(settings.relative_tolerance, settings.initial_residual_tolerance * initial);
+    attempt.initial_residual_tolerance = 0;
+    report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+    report.iterations += spent;
+    report.initial_relative_residual = initial;
+    return report;
+  }
+
+  /// Remembers the first solve's iterations after a build; a solve far above them asks for a
+  /// rebuild at the next update.
+  SolveReport track(const SolveReport& report) {
+    if (baseline_iterations_ < 0) baseline_iterations_ = report.iterations;
+    else if (report.iterations > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
+    return report;
+  }
+
   SolveSettings settings_;
   MultigridOptions options_;
   SparseMatrix a_;                      ///< the matrix of the last setup (the levels' source)
@@ -86,6 +129,7 @@ class MultigridCgSolver final : public LinearSolver {
   int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
   int baseline_iterations_ = -1;  ///< iterations of the first solve after the build
   bool rebuild_requested_ = false;
+  const LinkedVolume* topology_ = nullptr;  ///< of the last setup / update (the caller keeps it alive while solving)
 };
 
 }  // namespace
