@@ -20,6 +20,7 @@
 #include "cleave/viz/incision_ellipses.hpp"
 #include "cleave/viz/streamlines.hpp"
 #include "cleave/viz/wound_measures.hpp"
+#include "studio/cut_face_values.hpp"
 #include "studio/finite_message.hpp"
 
 namespace cleave::studio {
@@ -94,42 +95,6 @@ std::vector<float> residual_per_surface_vertex(const LinkedVolume& volume, const
       out[v] = static_cast<float>(force.segment<3>(3 * static_cast<Eigen::Index>(w)).norm() / (h * h));
       break;
     }
-  }
-  return out;
-}
-
-struct CutFaceValues {
-  bool any = false;
-  std::vector<float> depth;         ///< per surface vertex: 0 skin .. 1 inner layer; -1 off the cut faces
-  std::vector<float> traction_kPa;  ///< per surface vertex: released traction; -1 off the cut faces
-};
-
-/// Per surface vertex, the mean over the cut faces around it of colour_cut_faces' values.
-CutFaceValues cut_face_values(const BodySurface& body, const TissueModel& cut_model, const RenderSurface& surface,
-                              std::span<const Vec6> stress_kPa) {
-  CutFaceValues out;
-  const std::vector<CellFace> faces = cut_faces(cut_model.volume);
-  if (faces.empty()) return out;
-  const CutFaceColours colours = colour_cut_faces(body, faces, stress_kPa);
-  const auto n = static_cast<std::size_t>(surface.vertex_count());
-  std::vector<double> depth(n, 0.0), traction(n, 0.0);
-  std::vector<int> count(n, 0);
-  for (std::size_t i = 0; i < faces.size(); ++i) {
-    const std::int32_t q = surface.quad_of_face[6 * static_cast<std::size_t>(faces[i].cell) + static_cast<std::size_t>(faces[i].face)];
-    if (q == kNone) continue;
-    for (SurfaceVertexId v : surface.quads[static_cast<std::size_t>(q)].vertices) {
-      depth[static_cast<std::size_t>(v)] += colours.depth[i];
-      traction[static_cast<std::size_t>(v)] += colours.released_traction_kPa[i];
-      ++count[static_cast<std::size_t>(v)];
-    }
-  }
-  out.depth.assign(n, -1.0f);
-  out.traction_kPa.assign(n, -1.0f);
-  for (std::size_t v = 0; v < n; ++v) {
-    if (count[v] == 0) continue;
-    out.any = true;
-    out.depth[v] = static_cast<float>(depth[v] / count[v]);
-    out.traction_kPa[v] = static_cast<float>(traction[v] / count[v]);
   }
   return out;
 }
@@ -261,6 +226,7 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   // Measurements sample the margins on the cut body's own surface (its split vertices).
   cut_body_surface_ = plan_.incisions.empty() ? nullptr : std::make_unique<BodySurface>(*preview_model_);
   held_cut_ = held_vertices(*preview_model_, simulation_);  // the case's supports on the cut body
+  cut_face_layout_ = cut_face_layout(*body_surface_, *preview_model_, *preview_surface_);
   cut_key_ = key;
   return true;
 }
@@ -398,10 +364,9 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   }
   if (!displacement_mm_.empty()) f["displacement_mm"] = float_array(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).
-  const CutFaceValues cut = cut_face_values(*body_surface_, *preview_model_, surface, stress_kPa_);
-  if (cut.any) {
-    f["cut_depth"] = float_array(cut.depth);
-    f["traction_kPa"] = float_array(cut.traction_kPa);
+  if (cut_face_layout_.any) {
+    f["cut_depth"] = float_array(cut_face_layout_.depth);
+    f["traction_kPa"] = float_array(cut_face_traction_kPa(cut_face_layout_, surface, stress_kPa_));
   }
   message["fields"] = f;
   if (fields && !design.strokes.empty()) {
