@@ -4,21 +4,38 @@
 #include <cmath>
 #include <limits>
 
+#include "cleave/viz/nearest_point_index.hpp"
+
 namespace cleave {
 namespace {
 
-/// Distance from p to the tangent plane of the nearest sample: exact on a flat or gently curved
-/// surface, where the distance to the nearest sample point would overestimate by up to half a
-/// cell (samples are face centres).
-double nearest_distance(std::span<const SurfacePoint> samples, const Vec3& p) {
-  double best = std::numeric_limits<double>::infinity();
-  const SurfacePoint* nearest = nullptr;
-  for (const SurfacePoint& s : samples) {
-    const double d = (s.position_mm - p).squaredNorm();
-    if (d < best) best = d, nearest = &s;
+/// The surface samples of one side with an index for their nearest one.
+class SampleLookup {
+ public:
+  SampleLookup(std::vector<SurfacePoint> samples, double bucket_mm)
+      : samples_(std::move(samples)), index_(positions(samples_), bucket_mm) {}
+  bool empty() const { return samples_.empty(); }
+
+  /// Distance from p to the tangent plane of the nearest sample: exact on a flat or gently
+  /// curved surface, where the distance to the nearest sample point would overestimate by up to
+  /// half a cell (samples are face centres). Infinite without samples.
+  double distance(const Vec3& p) const {
+    const std::size_t i = index_.nearest(p);
+    if (i == NearestPointIndex::npos) return std::numeric_limits<double>::infinity();
+    const SurfacePoint& s = samples_[i];
+    return std::abs(s.normal.dot(p - s.position_mm));
   }
-  return nearest ? std::abs(nearest->normal.dot(p - nearest->position_mm)) : best;
-}
+
+ private:
+  static std::vector<Vec3> positions(const std::vector<SurfacePoint>& samples) {
+    std::vector<Vec3> out;
+    out.reserve(samples.size());
+    for (const SurfacePoint& s : samples) out.push_back(s.position_mm);
+    return out;
+  }
+  std::vector<SurfacePoint> samples_;
+  NearestPointIndex index_;
+};
 
 }  // namespace
 
@@ -38,15 +55,16 @@ std::array<float, 3> red_blue(double value, double lo, double hi) {
 }
 
 std::vector<double> depth_between_skin_and_inner_layer(const BodySurface& surface, std::span<const Vec3> points_mm) {
-  const std::vector<SurfacePoint> skin = surface.samples(SurfaceSide::outer);
-  const std::vector<SurfacePoint> inner = surface.samples(SurfaceSide::inner);
+  const double bucket_mm = 2 * surface.cell_size_mm();
+  const SampleLookup skin(surface.samples(SurfaceSide::outer), bucket_mm);
+  const SampleLookup inner(surface.samples(SurfaceSide::inner), bucket_mm);
   std::vector<double> out;
   out.reserve(points_mm.size());
   for (const Vec3& p : points_mm) {
-    const double d_skin = nearest_distance(skin, p);
+    const double d_skin = skin.distance(p);
     double d;
     if (!inner.empty()) {
-      const double d_inner = nearest_distance(inner, p);
+      const double d_inner = inner.distance(p);
       d = d_skin + d_inner > 0 ? d_skin / (d_skin + d_inner) : 0;
     } else {
       const auto s = surface.project(p, std::numeric_limits<double>::infinity());
