@@ -59,7 +59,7 @@ class StudioCompute {
   /// held_vertices are those of the uncut model.
   StressDesign design_settings_;
   SimulationSettings simulation_;
-  std::vector<VertexId> held_cut_;                    ///< held vertices of preview_model_
+  std::vector<VertexId> held_cut_;                    ///< held vertices of preview_model_ (the case's supports and the removed plugs)
   std::unique_ptr<BodySurface> body_surface_;         ///< of the uncut model
   std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
   std::unique_ptr<StressDesigner> designer_;
