@@ -63,7 +63,7 @@ class MultigridCgSolver final : public LinearSolver {
     preconditioner_ = MultigridPreconditioner();
     copy_block_values(a_blocks_, a_);
     build(*topology_);
-    SolveSettings rest = continuation(stale, settings_.max_iterations - stale.iterations);
+    const SolveSettings rest = continuation(settings_, stale, settings_.max_iterations - stale.iterations);
     SolveReport report = solve_with(b, x, rest);
     baseline_iterations_ = report.iterations;
     report.iterations += stale.iterations;
@@ -82,12 +82,12 @@ class MultigridCgSolver final : public LinearSolver {
     rebuild_requested_ = false;
   }
 
-  /// Settings to go on from where `first` left x: the initial-residual rule refers to the
+  /// `settings` to go on from where `first` left x: the initial-residual rule refers to the
   /// caller's initial guess, so it becomes an absolute tolerance.
-  SolveSettings continuation(const SolveReport& first, int iterations_left) const {
-    SolveSettings rest = settings_;
+  static SolveSettings continuation(const SolveSettings& settings, const SolveReport& first, int iterations_left) {
+    SolveSettings rest = settings;
     rest.max_iterations = iterations_left;
-    rest.relative_tolerance = std::max(settings_.relative_tolerance, settings_.initial_residual_tolerance * first.initial_relative_residual);
+    rest.relative_tolerance = std::max(settings.relative_tolerance, settings.initial_residual_tolerance * first.initial_relative_residual);
     rest.initial_residual_tolerance = 0;
     return rest;
   }
@@ -98,18 +98,14 @@ class MultigridCgSolver final : public LinearSolver {
       return preconditioned_cg(a_blocks_, b, x, preconditioner_, settings);
     SolveSettings attempt = settings;
     attempt.max_iterations = std::min(settings.max_iterations, kSinglePrecisionMaxIterations);
-    SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
-    if (report.converged || report.iterations >= settings.max_iterations) return report;
+    const SolveReport single = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+    if (single.converged || single.iterations >= settings.max_iterations) return single;
     // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
     preconditioner_.use_double_precision(a_blocks_);
-    const int spent = report.iterations;
-    const double initial = report.initial_relative_residual;
-    attempt.max_iterations = settings.max_iterations - spent;
-    attempt.relative_tolerance = std::max(settings.relative_tolerance, settings.initial_residual_tolerance * initial);
-    attempt.initial_residual_tolerance = 0;
-    report = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
-    report.iterations += spent;
-    report.initial_relative_residual = initial;
+    SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_,
+                                           continuation(settings, single, settings.max_iterations - single.iterations));
+    report.iterations += single.iterations;
+    report.initial_relative_residual = single.initial_relative_residual;
     return report;
   }
 
