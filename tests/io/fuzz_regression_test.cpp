@@ -38,14 +38,7 @@ int replay(const std::string& target, Read read) {
   return files;
 }
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no InputError";
-}
+using test::input_error_of;
 
 TEST(FuzzRegressions, EveryFormerCrashGivesAResultOrOneInputError) {
   int files = 0;
@@ -60,7 +53,7 @@ TEST(FuzzRegressions, EveryFormerCrashGivesAResultOrOneInputError) {
 // nifti_image_read (it copies dim[1..dim[0]] into an array of 8).
 TEST(FuzzRegressions, NiftiDimensionCountOutOfRange) {
   const auto file = kRegressions / "nifti" / "nifti2_dim0_overflow.nii";
-  EXPECT_EQ(error_of([&] { (void)read_nifti_volume(file); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_nifti_volume(file); }),
             file.string() + ": header dim[0] is 4294967299; expected 1 to 7 dimensions");
 }
 
@@ -68,7 +61,7 @@ TEST(FuzzRegressions, NiftiDimensionCountOutOfRange) {
 // nifti_image_load allocate them all before finding the data missing.
 TEST(FuzzRegressions, NiftiDeclaringMoreSamplesThanTheFileHoldsIsRefusedBeforeAllocating) {
   const auto file = kRegressions / "nifti" / "header_declares_5_7_GB.nii";
-  const std::string error = error_of([&] { (void)read_nifti_volume(file); });
+  const std::string error = input_error_of([&] { (void)read_nifti_volume(file); });
   EXPECT_EQ(error.rfind(file.string() + ": the image data is truncated or unreadable (expected ", 0), 0u) << error;
 }
 
@@ -77,7 +70,7 @@ TEST(FuzzRegressions, NiftiDeclaringMoreSamplesThanTheFileHoldsIsRefusedBeforeAl
 // nifticlib used the swapped one and overflowed its stack copying dim[1..dim[0]].
 TEST(FuzzRegressions, ByteSwappedNifti2DimensionCountIsJudgedSwapped) {
   const auto file = kRegressions / "nifti" / "nifti2_swapped_dim0_overflow.nii";
-  EXPECT_EQ(error_of([&] { (void)read_nifti_volume(file); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_nifti_volume(file); }),
             file.string() + ": header dim[0] is 72057594037927936; expected 1 to 7 dimensions");
 }
 
@@ -85,7 +78,7 @@ TEST(FuzzRegressions, ByteSwappedNifti2DimensionCountIsJudgedSwapped) {
 // leak on their error paths.
 TEST(FuzzRegressions, NrrdWithoutMagicIsRefusedBeforeTeem) {
   const auto file = kRegressions / "nrrd" / "no_magic_teem_leak.nrrd";
-  EXPECT_EQ(error_of([&] { (void)read_nrrd_volume(file); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_nrrd_volume(file); }),
             file.string() + ": not a NRRD file (expected the magic 'NRRD000' at the start)");
 }
 
@@ -95,7 +88,7 @@ TEST(FuzzRegressions, PlyFaceWithoutCornersIsRefusedBeforePostProcessing) {
   const auto file = kRegressions / "mesh_ply" / "ascii_face_without_corners.ply";
   // The ASCII walk before assimp now refuses its non-numeric list count; the check of imported
   // faces stays behind it as a second guard.
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }).rfind(file.string() + ": element 'face' 0 has a list of '", 0),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }).rfind(file.string() + ": element 'face' 0 has a list of '", 0),
             0u);
 }
 
@@ -108,7 +101,7 @@ TEST(FuzzRegressions, PlyFaceWithoutCornersIsRefusedBeforePostProcessing) {
 // face list before reading the body.
 TEST(FuzzRegressions, MalformedAsciiPlyBodiesNeverReachAssimp) {
   const auto file = kRegressions / "mesh_ply" / "ascii_body_garbage_heap_corruption.ply";
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
             file.string() + ": PLY element 'face' has no list property 'vertex_indices' (or 'vertex_index')");
   test::TempFolder tmp;
   const std::string header =
@@ -116,7 +109,7 @@ TEST(FuzzRegressions, MalformedAsciiPlyBodiesNeverReachAssimp) {
       "element face 1\nproperty list uchar int vertex_indices\nend_header\n";
   const auto error_for = [&](const std::string& body) {
     test::write_bytes(tmp / "m.ply", header + body);
-    return error_of([&] { (void)read_surface_mesh(tmp / "m.ply", 1.0); });
+    return input_error_of([&] { (void)read_surface_mesh(tmp / "m.ply", 1.0); });
   };
   const std::string m = (tmp / "m.ply").string();
   EXPECT_EQ(error_for("0 0 0\n1 0 0\n0 1 zero\n3 0 1 2\n"), m + ": element 'vertex' 2 has the value 'zero'; expected a number");
@@ -135,12 +128,12 @@ TEST(FuzzRegressions, MalformedAsciiPlyBodiesNeverReachAssimp) {
 // exact: one format line before the elements, whole element counts, nothing after a line's fields.
 TEST(FuzzRegressions, PlyHeaderLinesMustBeExact) {
   const auto file = kRegressions / "mesh_ply" / "header_garbage_heap_corruption.ply";
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
             file.string() + ": malformed PLY header line 'element fac 0.0ace 13'");
   test::TempFolder tmp;
   const auto error_for = [&](const std::string& header) {
     test::write_bytes(tmp / "h.ply", header + "end_header\n0 0 0\n");
-    return error_of([&] { (void)read_surface_mesh(tmp / "h.ply", 1.0); });
+    return input_error_of([&] { (void)read_surface_mesh(tmp / "h.ply", 1.0); });
   };
   const std::string h = (tmp / "h.ply").string();
   EXPECT_EQ(error_for("ply\nelement vertex 1\nproperty float x\n"),
@@ -161,7 +154,7 @@ TEST(FuzzRegressions, PlyHeaderLinesMustBeExact) {
 // fuzz_mesh_ply: a binary PLY header without end_header made assimp read past its buffer.
 TEST(FuzzRegressions, PlyWithoutEndHeaderIsRefusedBeforeAssimp) {
   const auto file = kRegressions / "mesh_ply" / "binary_without_end_header.ply";
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
             file.string() + ": not a PLY file (expected 'ply' first and an 'end_header' line)");
 }
 
@@ -170,7 +163,7 @@ TEST(FuzzRegressions, PlyWithoutEndHeaderIsRefusedBeforeAssimp) {
 TEST(FuzzRegressions, PlyHeadersThatHungAssimpAreRefused) {
   for (const char* name : {"unknown_header_lines_hang.ply", "end_header_suffix_hang.ply"}) {
     const auto file = kRegressions / "mesh_ply" / name;
-    EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+    EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
               file.string() + ": not a PLY file (expected 'ply' first and an 'end_header' line)");
   }
   const auto file = std::filesystem::temp_directory_path() / ("cleave_unknown_line_" + std::to_string(::getpid()) + ".ply");
@@ -178,7 +171,7 @@ TEST(FuzzRegressions, PlyHeadersThatHungAssimpAreRefused) {
     std::ofstream out(file, std::ios::binary);
     out << "ply\nformat ascii 1.0\nelement vertex 1\npropert\xe3y float x\nend_header\n0\n";
   }
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
             file.string() + ": malformed PLY header line 'propert\xEF\xBF\xBDy float x'");
   std::filesystem::remove(file);
 }
@@ -187,7 +180,7 @@ TEST(FuzzRegressions, PlyHeadersThatHungAssimpAreRefused) {
 // digits made assimp allocate 64 GB; the format, its version and element names are checked first.
 TEST(FuzzRegressions, PlyUnknownFormatIsRefusedBeforeAssimp) {
   const auto file = kRegressions / "mesh_ply" / "unknown_format_huge_allocation.ply";
-  EXPECT_EQ(error_of([&] { (void)read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { (void)read_surface_mesh(file, 1.0); }),
             file.string() + ": malformed PLY header line 'format binary_big_endia\xEF\xBF\xBD 1.0'");
 }
 
@@ -205,13 +198,13 @@ bool is_valid_utf8(const std::string& s) {
 // threw (an exception out of the server's read handler ends the server).
 TEST(FuzzRegressions, JsonErrorMessagesAreValidUtf8) {
   const std::string bad = "{\"cmd\": \"\xf9\xf9vtu\"}";
-  const std::string message = error_of([&] { (void)parse_json_text(bad, "message"); });
+  const std::string message = input_error_of([&] { (void)parse_json_text(bad, "message"); });
   EXPECT_NE(message.find("invalid JSON at byte"), std::string::npos) << message;
   EXPECT_TRUE(is_valid_utf8(message)) << message;
   // A value quoted in an error is cut at 60 bytes without splitting a character.
   const std::string long_value(30, 'x');
   const std::string accented = long_value + "\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9\xc3\xa9";
-  const std::string quoted = error_of([&] { json_error(JsonPath{"f", "/cmd"}, nlohmann::json(accented), "a name"); });
+  const std::string quoted = input_error_of([&] { json_error(JsonPath{"f", "/cmd"}, nlohmann::json(accented), "a name"); });
   EXPECT_TRUE(is_valid_utf8(quoted)) << quoted;
 }
 

@@ -6,6 +6,7 @@
 #include <cstdint>
 #include <filesystem>
 #include <fstream>
+#include <functional>
 #include <map>
 #include <string>
 #include <unistd.h>
@@ -14,6 +15,7 @@
 #include <Eigen/Geometry>
 #include <gtest/gtest.h>
 
+#include "cleave/core/error.hpp"
 #include "cleave/core/types.hpp"
 #include "cleave/io/surface_mesh_file.hpp"
 
@@ -35,6 +37,16 @@ struct TempFolder {
   }
   std::filesystem::path operator/(const std::string& name) const { return path / name; }
 };
+
+/// The message of the InputError `f` throws, or "no InputError" (for exact-message assertions).
+inline std::string input_error_of(const std::function<void()>& f) {
+  try {
+    f();
+  } catch (const InputError& e) {
+    return e.what();
+  }
+  return "no InputError";
+}
 
 inline void write_bytes(const std::filesystem::path& file, const std::string& bytes) {
   std::ofstream out(file, std::ios::binary);

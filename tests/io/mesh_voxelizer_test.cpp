@@ -27,14 +27,7 @@ double voxel_volume_mm3(const LabelVolume& v) {
   return static_cast<double>(v.inside_count()) * std::pow(v.grid.cell_size_mm, 3);
 }
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no InputError";
-}
+using test::input_error_of;
 
 struct MeshFormat {
   std::string extension;
@@ -164,7 +157,7 @@ TEST(RealData, CgalManOffRefusesAGridThatWouldNotFit) {
   ModelSourceOptions options;
   options.mesh_scale = 1750.0;
   options.cell_size_mm = 0.001;
-  const std::string message = message_of([&] { load_model_source(man.string(), options); });
+  const std::string message = input_error_of([&] { load_model_source(man.string(), options); });
   EXPECT_THAT(message, HasSubstr(man.string() + " at cell size 0.001 mm (a "));
   EXPECT_THAT(message, HasSubstr("x1750002 grid)")) << "1750 mm tall plus a padding cell on each side";
   EXPECT_THAT(message, HasSubstr("would need"));
@@ -175,14 +168,14 @@ TEST(RealData, CgalManOffRefusesAGridThatWouldNotFit) {
 // Bad meshes: one clear line naming the file and the problem.
 
 TEST(BadMesh, MissingFile) {
-  EXPECT_EQ(message_of([] { read_surface_mesh("/nonexistent/body.obj", 1.0); }), "/nonexistent/body.obj: no such file");
+  EXPECT_EQ(input_error_of([] { read_surface_mesh("/nonexistent/body.obj", 1.0); }), "/nonexistent/body.obj: no such file");
 }
 
 TEST(BadMesh, MalformedObj) {
   TempFolder tmp;
   const auto file = tmp / "garbage.obj";
   test::write_bytes(file, "v 0 0 0\nv 1 0 0\nf 1 2 99\n");
-  EXPECT_THAT(message_of([&] { read_surface_mesh(file, 1.0); }), HasSubstr(file.string() + ": cannot read the mesh: "));
+  EXPECT_THAT(input_error_of([&] { read_surface_mesh(file, 1.0); }), HasSubstr(file.string() + ": cannot read the mesh: "));
 }
 
 TEST(BadMesh, TruncatedBinaryStl) {
@@ -190,14 +183,14 @@ TEST(BadMesh, TruncatedBinaryStl) {
   const auto file = tmp / "truncated.stl";
   const std::string full = test::to_binary_stl(test::icosphere({0, 0, 0}, 1.0, 2));
   test::write_bytes(file, full.substr(0, full.size() / 2));
-  EXPECT_THAT(message_of([&] { read_surface_mesh(file, 1.0); }), HasSubstr(file.string() + ": cannot read the mesh: "));
+  EXPECT_THAT(input_error_of([&] { read_surface_mesh(file, 1.0); }), HasSubstr(file.string() + ": cannot read the mesh: "));
 }
 
 TEST(BadMesh, TruncatedOff) {
   TempFolder tmp;
   const auto file = tmp / "truncated.off";
   test::write_bytes(file, "OFF\n4 4 0\n0 0 0\n1 0 0\n");
-  EXPECT_EQ(message_of([&] { read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { read_surface_mesh(file, 1.0); }),
             file.string() + ": the file ends at line 4 while expecting a vertex (truncated?)");
 }
 
@@ -205,17 +198,17 @@ TEST(BadMesh, OffFaceIndexOutOfRangeAndBadNumber) {
   TempFolder tmp;
   const auto file = tmp / "bad_index.off";
   test::write_bytes(file, "OFF\n# a comment\n3 1 0\n0 0 0\n1 0 0\n0 1 0\n3 0 1 7\n");
-  EXPECT_EQ(message_of([&] { read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { read_surface_mesh(file, 1.0); }),
             file.string() + ": line 7: face 0 refers to vertex 7; the file has 3 vertices");
   test::write_bytes(file, "OFF\n3 1 0\n0 0 0\n1 zero 0\n0 1 0\n3 0 1 2\n");
-  EXPECT_EQ(message_of([&] { read_surface_mesh(file, 1.0); }), file.string() + ": line 4: 'zero' is not a valid coordinate");
+  EXPECT_EQ(input_error_of([&] { read_surface_mesh(file, 1.0); }), file.string() + ": line 4: 'zero' is not a valid coordinate");
 }
 
 TEST(BadMesh, NanCoordinateInOff) {
   TempFolder tmp;
   const auto file = tmp / "nan.off";
   test::write_bytes(file, "OFF\n3 1 0\n0 0 0\n1 nan 0\n0 1 0\n3 0 1 2\n");
-  EXPECT_EQ(message_of([&] { read_surface_mesh(file, 1.0); }),
+  EXPECT_EQ(input_error_of([&] { read_surface_mesh(file, 1.0); }),
             file.string() + ": vertex 1 is (1, nan, 0); expected finite coordinates");
 }
 
@@ -225,7 +218,7 @@ TEST(BadMesh, NanCoordinate) {
   TriangleMesh m = test::icosphere({0, 0, 0}, 1.0, 1);
   m.vertices_mm[3].y() = std::numeric_limits<double>::quiet_NaN();
   test::write_bytes(file, test::to_binary_stl(m));
-  const std::string message = message_of([&] { read_surface_mesh(file, 1.0); });
+  const std::string message = input_error_of([&] { read_surface_mesh(file, 1.0); });
   EXPECT_THAT(message, HasSubstr(file.string() + ": vertex "));
   EXPECT_THAT(message, HasSubstr("nan"));
   EXPECT_THAT(message, HasSubstr("expected finite coordinates"));
@@ -237,7 +230,7 @@ TEST(BadMesh, FlatOpenSquareEnclosesNothing) {
   test::write_bytes(file, "v 0 0 0\nv 100 0 0\nv 100 100 0\nv 0 100 0\nf 1 2 3\nf 1 3 4\n");
   ModelSourceOptions options;
   options.cell_size_mm = 5.0;
-  EXPECT_EQ(message_of([&] { load_model_source(file.string(), options); }),
+  EXPECT_EQ(input_error_of([&] { load_model_source(file.string(), options); }),
             file.string() + ": the mesh encloses no volume at cell size 5 mm (an open, flat or degenerate surface "
                             "has no inside); expected a closed surface thicker than a cell");
 }
@@ -246,19 +239,19 @@ TEST(BadMesh, AllVerticesCoincide) {
   TriangleMesh m;
   m.vertices_mm = {{1, 1, 1}, {1, 1, 1}, {1, 1, 1}};
   m.triangles = {{0, 1, 2}};
-  EXPECT_EQ(message_of([&] { voxelize_surface_mesh(m, {std::nullopt, "point.obj", {}}); }),
+  EXPECT_EQ(input_error_of([&] { voxelize_surface_mesh(m, {std::nullopt, "point.obj", {}}); }),
             "point.obj: all vertices coincide; the mesh encloses no volume");
 }
 
 TEST(BadMesh, NonPositiveScale) {
-  EXPECT_EQ(message_of([] { read_surface_mesh("any.obj", -2.0); }),
+  EXPECT_EQ(input_error_of([] { read_surface_mesh("any.obj", -2.0); }),
             "any.obj: mesh scale -2; expected a positive finite factor");
 }
 
 TEST(BadMesh, LabelsDoNotApplyToMeshes) {
   ModelSourceOptions options;
   options.labels = {2};
-  EXPECT_EQ(message_of([&] { load_model_source("body.obj", options); }),
+  EXPECT_EQ(input_error_of([&] { load_model_source("body.obj", options); }),
             "body.obj: labels and thresholds select parts of volumes; a mesh has none");
 }
 

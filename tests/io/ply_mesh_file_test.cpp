@@ -15,14 +15,7 @@
 namespace cleave {
 namespace {
 
-std::string error_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no InputError";
-}
+using test::input_error_of;
 
 /// Appends `value` as `bytes` bytes, little- or big-endian.
 void put(std::string& out, std::uint64_t value, std::size_t bytes, bool big_endian) {
@@ -106,7 +99,7 @@ TEST(PlyMeshFile, MalformedBodiesGetOneNamedError) {
   const std::string p = (tmp / "m.ply").string();
   const auto error_for = [&](const std::string& bytes) {
     test::write_bytes(tmp / "m.ply", bytes);
-    return error_of([&] { (void)read_surface_mesh(tmp / "m.ply", 1.0); });
+    return input_error_of([&] { (void)read_surface_mesh(tmp / "m.ply", 1.0); });
   };
   const std::string le = square_ply("binary_little_endian");
   EXPECT_EQ(error_for(le.substr(0, le.size() - 3)),

@@ -23,14 +23,7 @@ namespace {
 using test::TempFolder;
 using ::testing::HasSubstr;
 
-std::string message_of(const std::function<void()>& f) {
-  try {
-    f();
-  } catch (const InputError& e) {
-    return e.what();
-  }
-  return "no InputError";
-}
+using test::input_error_of;
 
 /// Writes a NIfTI file with nifticlib: samples[i + nx (j + ny k)] with the given voxel-to-world
 /// map (sform when `use_qform` is false, else qform via quaternion; the other code is 0).
@@ -350,14 +343,14 @@ TEST(ImageLabelSelection, KeepsOnlyTheSelectedLabelsWithTheirValues) {
 }
 
 TEST(ImageLabelSelection, AbsentLabelNamesItAndListsThePresentOnes) {
-  EXPECT_EQ(message_of([] { select_image_labels(three_label_image(), {{2, 7}, std::nullopt}); }),
+  EXPECT_EQ(input_error_of([] { select_image_labels(three_label_image(), {{2, 7}, std::nullopt}); }),
             "seg.nii: label 7 is absent; labels present: 1, 2, 5");
 }
 
 TEST(ImageLabelSelection, LabelsAbove255AreRefusedNotRemapped) {
   ImageVolume image = three_label_image();
   image.values[3] = 300;
-  EXPECT_EQ(message_of([&] { select_image_labels(image, {}); }),
+  EXPECT_EQ(input_error_of([&] { select_image_labels(image, {}); }),
             "seg.nii: label 300 does not fit cleave's tissue labels 1..255; select labels in that range (--label) "
             "or give a threshold (--threshold)");
   EXPECT_EQ(select_image_labels(image, {{5}, std::nullopt})[4], 5) << "selecting labels <= 255 still works";
@@ -366,7 +359,7 @@ TEST(ImageLabelSelection, LabelsAbove255AreRefusedNotRemapped) {
 TEST(ImageLabelSelection, NonIntegerValuesNeedAThreshold) {
   ImageVolume image = three_label_image();
   image.values[2] = 0.37;
-  EXPECT_EQ(message_of([&] { select_image_labels(image, {}); }),
+  EXPECT_EQ(input_error_of([&] { select_image_labels(image, {}); }),
             "seg.nii: sample 2 has the non-integer value 0.37, so this is an intensity image, not a label image; "
             "give a threshold (--threshold) to select the inside");
   const std::vector<Label> thresholded = select_image_labels(image, {{}, 1.5});
@@ -375,14 +368,14 @@ TEST(ImageLabelSelection, NonIntegerValuesNeedAThreshold) {
 
 TEST(ImageLabelSelection, EmptyMasks) {
   ImageVolume image = three_label_image();
-  EXPECT_EQ(message_of([&] { select_image_labels(image, {{}, 6.0}); }),
+  EXPECT_EQ(input_error_of([&] { select_image_labels(image, {{}, 6.0}); }),
             "seg.nii: the mask is empty: no sample is >= the threshold 6 (values range from 0 to 5)");
   std::fill(image.values.begin(), image.values.end(), 0.0);
-  EXPECT_EQ(message_of([&] { select_image_labels(image, {}); }), "seg.nii: the mask is empty: every sample is 0");
+  EXPECT_EQ(input_error_of([&] { select_image_labels(image, {}); }), "seg.nii: the mask is empty: every sample is 0");
 }
 
 TEST(ImageLabelSelection, LabelsAndThresholdExcludeEachOther) {
-  EXPECT_EQ(message_of([] { select_image_labels(three_label_image(), {{1}, 0.5}); }),
+  EXPECT_EQ(input_error_of([] { select_image_labels(three_label_image(), {{1}, 0.5}); }),
             "seg.nii: give either labels (for a segmentation) or a threshold (for an intensity image), not both");
 }
 
