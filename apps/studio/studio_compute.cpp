@@ -65,23 +65,6 @@ nlohmann::json float_array(const std::vector<float>& values, double step = kRoun
   return a;
 }
 
-/// The vertices that only `cells` use (no other cell of the volume has them as a corner).
-std::vector<VertexId> vertices_only_of(const LinkedVolume& volume, const std::vector<CellId>& cells) {
-  std::vector<std::uint8_t> in_set(static_cast<std::size_t>(volume.cell_count()), 0);
-  for (CellId c : cells) in_set[static_cast<std::size_t>(c)] = 1;
-  std::vector<std::uint8_t> used_elsewhere(static_cast<std::size_t>(volume.vertex_count()), 0);
-  for (CellId c = 0; c < volume.cell_count(); ++c)
-    if (!in_set[static_cast<std::size_t>(c)])
-      for (VertexId v : volume.cell_vertices(c)) used_elsewhere[static_cast<std::size_t>(v)] = 1;
-  std::vector<VertexId> out;
-  for (CellId c : cells)
-    for (VertexId v : volume.cell_vertices(c))
-      if (!used_elsewhere[static_cast<std::size_t>(v)]) out.push_back(v);
-  std::sort(out.begin(), out.end());
-  out.erase(std::unique(out.begin(), out.end()), out.end());
-  return out;
-}
-
 /// Triangle indices of `surface` without the hidden plugs of the round incisions.
 std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const CutPlan& plan) {
   std::vector<std::uint8_t> hidden(surface.quad_of_face.size() / 6, 0);
@@ -241,13 +224,9 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
   // Measurements sample the margins on the cut body's own surface (its split vertices).
   cut_body_surface_ = plan_.incisions.empty() ? nullptr : std::make_unique<BodySurface>(*preview_model_);
-  held_cut_ = held_vertices(*preview_model_, simulation_);  // the case's supports on the cut body
-  // Removed plugs are hidden and touch nothing: held in place they cost the solvers nothing
-  // (free, corotated plugs were the multigrid's slowest case: 55-77 iterations per step at 45k).
-  const std::vector<VertexId> plugs = vertices_only_of(preview_model_->volume, plan_.hidden_cells());
-  held_cut_.insert(held_cut_.end(), plugs.begin(), plugs.end());
-  std::sort(held_cut_.begin(), held_cut_.end());
-  held_cut_.erase(std::unique(held_cut_.begin(), held_cut_.end()), held_cut_.end());
+  // The case's supports on the cut body, and the removed plugs (hidden, touching nothing: free,
+  // corotated plugs had made the multigrid need 55-77 iterations per step at 45k cells).
+  held_cut_ = held_vertices(*preview_model_, simulation_, plan_.hidden_cells());
   cut_face_layout_ = cut_face_layout(*body_surface_, *preview_model_, *preview_surface_);
   cut_key_ = key;
   return true;

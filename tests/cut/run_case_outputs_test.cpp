@@ -1,6 +1,7 @@
 // What `cleave run` writes for cuts, checked on the files a user opens:
 //   - the cut faces carry their colouring (released traction ||sigma n||, depth) in surface.ply
 //     (triangle and vertex arrays, vertex colours) and in result.vtu (cell arrays);
+//   - removed plugs are held in place (no free pieces);
 //   - a dynamic run writes frames.pvd, a ParaView series of frame_NNNN.vtu files;
 //   - the demo's case (built-in abdomen, Langer design): every incision where the designed
 //     eigenvalue ratio is at least 1.5 opens into an ellipse whose long axis lies within 10
@@ -112,6 +113,41 @@ TEST(RunCaseOutputs, CutFacesCarryReleasedTractionAndDepthInSurfaceAndVolume) {
   ASSERT_EQ(cell_depth.size(), cell_traction_Pa.size());
   EXPECT_NEAR(*std::max_element(cell_traction_Pa.begin(), cell_traction_Pa.end()), 20000.0, 1e-6);
   EXPECT_NE(read_text(dir / "surface.gltf").find("RELEASED_TRACTION_KPA"), std::string::npos);
+}
+
+TEST(RunCaseOutputs, RemovedPlugsAreHeldInPlaceAndAreNoFreePieces) {
+  // One round incision through half the plate: its plug is cut free and removed. The mechanics
+  // holds every vertex of the plug (it touches nothing) instead of treating it as a free piece.
+  json c = plate_case();
+  c["incisions"] = {{"radius_mm", 12}, {"depth_mm", 5}, {"plug", "remove"}, {"at_mm", {{50, 50, 10}}}};
+  const auto dir = fresh_dir("plug");
+  const json summary = run(c, dir);
+  const int removed = summary["cut"]["removed_cells"].get<int>();
+  ASSERT_GT(removed, 0);
+  EXPECT_EQ(summary["mechanics"]["held_removed_cells"].get<int>(), removed);
+  EXPECT_EQ(summary["mechanics"]["free_components"].get<int>(), 0);
+
+  const std::string vtu = read_text(dir / "result.vtu");
+  const std::vector<double> removed_cell = vtu_array(vtu, "removed");
+  const std::vector<double> fixed = vtu_array(vtu, "fixed");
+  const std::vector<double> displacement = vtu_array(vtu, "displacement");
+  const std::vector<double> connectivity = vtu_array(vtu, "connectivity");
+  ASSERT_EQ(connectivity.size(), 8 * removed_cell.size());
+  ASSERT_EQ(displacement.size(), 3 * fixed.size());
+  int plug_cells = 0;
+  for (std::size_t cell = 0; cell < removed_cell.size(); ++cell) {
+    if (removed_cell[cell] < 0.5) continue;
+    ++plug_cells;
+    for (std::size_t k = 0; k < 8; ++k) {
+      const auto v = static_cast<std::size_t>(connectivity[8 * cell + k]);
+      EXPECT_EQ(fixed[v], 1.0) << "vertex " << v;
+      for (std::size_t i = 0; i < 3; ++i) EXPECT_EQ(displacement[3 * v + i], 0.0) << "vertex " << v;
+    }
+  }
+  EXPECT_EQ(plug_cells, removed);
+  // The opened hole itself moves: the plate's stress is released at its wall.
+  EXPECT_GT(summary["mechanics"]["max_displacement_mm"].get<double>(), 0.05);
+  EXPECT_EQ(summary["incisions_overview"]["measured"].get<int>(), 1);
 }
 
 TEST(RunCaseOutputs, DynamicRunWritesAParaViewSeriesOfFrames) {

@@ -143,7 +143,7 @@ TEST(MechanicsStage, UniformStressOnAFreePlateIsFullyReleased) {
   const CaseFile c = case_from(R"(, "residual_stress": {"uniform_kPa": [12, 12, 0, 0, 0, 0]},
                                    "simulation": {"mode": "static", "solver": "cholmod", "tolerance": 1e-12, "fixed": "free"})");
   RunContext ctx{c, std::filesystem::temp_directory_path(), {}, test::make_box_model({6, 4, 1}, 2.0, 80.0, 0.4), {}, {}, {}, {}, nlohmann::json::object(),
-                 nlohmann::json::object()};
+                 nlohmann::json::object(), {}};
   stage_mechanics(ctx);
   const LinkedVolume& volume = ctx.model.volume;
   ASSERT_EQ(ctx.displacement_mm.size(), static_cast<std::size_t>(volume.vertex_count()));
@@ -172,7 +172,7 @@ TEST(MechanicsStage, DynamicRunWritesFramesAndHoldsTheFixedBox) {
   const CaseFile c = case_from(R"(, "residual_stress": {"uniform_kPa": [12, 6, 0, 0, 0, 0]},
       "simulation": {"mode": "dynamic", "solver": "cholmod", "time_step_s": 0.001, "steps": 20, "steps_per_frame": 5,
                      "frames_every": 2, "damping": {"mass_per_s": 50}, "fixed": {"box_mm": [[-1, -1, -1], [0.5, 9, 9]]}})");
-  RunContext ctx{c, out, {}, test::make_box_model({6, 4, 1}, 2.0), {}, {}, {}, {}, nlohmann::json::object(), nlohmann::json::object()};
+  RunContext ctx{c, out, {}, test::make_box_model({6, 4, 1}, 2.0), {}, {}, {}, {}, nlohmann::json::object(), nlohmann::json::object(), {}};
   stage_mechanics(ctx);
   ASSERT_EQ(ctx.frames.size(), 3u);  // t = 0, 0.01 s, 0.02 s
   EXPECT_NEAR(ctx.frames.back().time_s, 0.02, 1e-12);

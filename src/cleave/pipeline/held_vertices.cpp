@@ -1,9 +1,11 @@
 #include "cleave/pipeline/held_vertices.hpp"
 
+#include <algorithm>
 #include <cstdint>
 
 #include "cleave/cut/surface_side_vertices.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
+#include "cleave/grid/vertices_only_of.hpp"
 
 namespace cleave {
 
@@ -22,6 +24,17 @@ std::vector<VertexId> held_vertices(const TissueModel& model, const SimulationSe
   std::vector<VertexId> out;
   for (VertexId v = 0; v < volume.vertex_count(); ++v)
     if (held[static_cast<std::size_t>(v)]) out.push_back(v);
+  return out;
+}
+
+std::vector<VertexId> held_vertices(const TissueModel& model, const SimulationSettings& settings,
+                                    std::span<const CellId> removed_cells) {
+  std::vector<VertexId> out = held_vertices(model, settings);
+  const std::vector<VertexId> removed = vertices_only_of(model.volume, removed_cells);
+  const auto supports_end = static_cast<std::ptrdiff_t>(out.size());
+  out.insert(out.end(), removed.begin(), removed.end());
+  std::inplace_merge(out.begin(), out.begin() + supports_end, out.end());
+  out.erase(std::unique(out.begin(), out.end()), out.end());
   return out;
 }
 

@@ -19,7 +19,7 @@ void timed(RunContext& ctx, const char* name, Stage&& stage) {
 }  // namespace
 
 RunResult run_case(const CaseFile& case_file, const std::filesystem::path& out_dir, const ProgressFn& progress) {
-  RunContext ctx{case_file, out_dir, progress, {}, {}, {}, {}, {}, nlohmann::json::object(), nlohmann::json::object()};
+  RunContext ctx{case_file, out_dir, progress, {}, {}, {}, {}, {}, nlohmann::json::object(), nlohmann::json::object(), {}};
   timed(ctx, "model", [&](RunContext& c) {
     ModelSourceOptions options = case_file.model_options;
     options.progress = progress;

@@ -28,6 +28,8 @@ struct RunContext {
   nlohmann::json summary = nlohmann::json::object();  ///< written to summary.json
   /// Cut-domain state the cut stage leaves for the measure stage (incisions, scalpel paths).
   nlohmann::json cut_state = nlohmann::json::object();
+  /// Removed plugs the cut stage leaves for the mechanics stage: hidden, held in place.
+  std::vector<CellId> removed_cells;
 
   /// Adds `seconds` under summary["timings_s"][stage].
   void record_time(const std::string& stage, double seconds) { summary["timings_s"][stage] = seconds; }

@@ -1,7 +1,7 @@
 // Stage "cuts" of a batch run: the case's "incisions" and "cuts" sections (io/case_cuts.hpp).
 // Every request is validated before the linked volume is touched; then incisions, scalpel cuts
 // and flaps are cut in that order. Adds the cell field "removed" (1 for the cells of removed
-// plugs: free pieces not to display) and summary["cut"]: counts of requests, links cut, vertices
+// plugs: cut-free pieces not displayed, which the mechanics stage holds) and summary["cut"]: counts of requests, links cut, vertices
 // split and components.
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/io/case_cuts.hpp"
@@ -25,7 +25,8 @@ void stage_cuts(RunContext& ctx) {
     report(ctx.progress, "cuts", static_cast<double>(i + 1) / static_cast<double>(plan.steps.size()));
   }
   DataArray removed{"removed", 1, std::vector<double>(static_cast<std::size_t>(volume.cell_count()), 0.0)};
-  const std::vector<CellId> hidden = plan.hidden_cells();
+  ctx.removed_cells = plan.hidden_cells();
+  const std::vector<CellId>& hidden = ctx.removed_cells;
   for (const CellId c : hidden) removed.values[static_cast<std::size_t>(c)] = 1.0;
   ctx.fields.cell_data.push_back(std::move(removed));
   ctx.summary["cut"] = {{"incisions", requests.incisions.size()},

@@ -48,10 +48,12 @@ void stage_mechanics(RunContext& ctx) {
   const LinkedVolume& volume = ctx.model.volume;
   if (ctx.residual_stress_kPa.empty())
     if (auto direct = parse_direct_residual_stress(ctx.case_file, ctx.model)) ctx.residual_stress_kPa = std::move(*direct);
-  const std::vector<VertexId> held = held_vertices(ctx.model, settings);
+  // The supports, and the removed plugs of round incisions (hidden, touching nothing).
+  const std::vector<VertexId> held = held_vertices(ctx.model, settings, ctx.removed_cells);
   const bool loaded = !ctx.residual_stress_kPa.empty() || !settings.gravity_mm_per_s2.isZero();
   nlohmann::json summary = {{"mode", settings.mode == SimulationMode::dynamic ? "dynamic" : "static"},
-                            {"fixed_vertices", held.size()}};
+                            {"fixed_vertices", held.size()},
+                            {"held_removed_cells", ctx.removed_cells.size()}};
 
   ctx.displacement_mm.assign(static_cast<std::size_t>(volume.vertex_count()), Vec3::Zero());
   if (!loaded) {
