@@ -5,6 +5,7 @@
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/fem/assemble_stiffness.hpp"
 #include "cleave/fem/static_solver.hpp"
+#include "cleave/grid/vertices_only_of.hpp"
 #include "cleave/stress/stress_designer.hpp"
 #include "cleave/surface/render_surface.hpp"
 #include "implementation_setup.hpp"
@@ -55,13 +56,16 @@ struct IncisedPreview {
   TissueModel model;
   SparseMatrix stiffness;
   RenderSurface surface;
+  std::vector<VertexId> held;  ///< the removed plugs' vertices, held as the studio holds them
 };
 
 IncisedPreview incised_preview(const TissueModel& uncut, const BenchScenario& scenario) {
-  IncisedPreview p{uncut, {}, {}};
+  IncisedPreview p{uncut, {}, {}, {}};
   {
     const BodySurface body(p.model);
-    apply_cut_plan(p.model.volume, plan_cuts(body, scenario.incisions));
+    const CutPlan plan = plan_cuts(body, scenario.incisions);
+    apply_cut_plan(p.model.volume, plan);
+    p.held = vertices_only_of(p.model.volume, plan.hidden_cells());
   }
   p.stiffness = assemble_stiffness(p.model);
   p.surface = build_render_surface(p.model);
@@ -75,10 +79,11 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
   int preview_iterations = 0;
   std::vector<Vec3> picture_mm;  // deformed render surface vertices: what the page draws
   // The preview's statics are kept across edits as the studio keeps them: CHOLMOD's factor of the
-  // incised body, made at the first edit's solve, then one forward/back substitution per edit
-  // (multigrid from scratch needed 65-77 iterations here: the removed plugs are free pieces).
+  // incised body (removed plugs held), made at the first edit's solve, then one forward/back
+  // substitution per edit.
   StaticOptions kept;
   kept.solver = SolverKind::cholmod;
+  kept.fixed_vertices = preview.held;
   StaticSolver statics(preview.model, preview.stiffness, kept);
   for (int edit = 0; edit < repeat; ++edit) {
     update_ms.push_back(wall_time_ms([&] {

@@ -6,6 +6,7 @@
 #include "cleave/fem/assemble_stiffness.hpp"
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/solve_static.hpp"
+#include "cleave/grid/vertices_only_of.hpp"
 #include "implementation_setup.hpp"
 
 namespace cleave::bench {
@@ -22,13 +23,15 @@ Eigen::VectorXd flatten(const std::vector<Vec3>& per_vertex) {
 MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchScenario& scenario,
                                           Implementation implementation, int repeat) {
   TissueModel model = uncut;
+  StaticOptions options;
   {
     const BodySurface surface(model);
-    apply_cut_plan(model.volume, plan_cuts(surface, scenario.incisions));
+    const CutPlan plan = plan_cuts(surface, scenario.incisions);
+    apply_cut_plan(model.volume, plan);
+    options.fixed_vertices = vertices_only_of(model.volume, plan.hidden_cells());  // removed plugs, as in the studio
   }
   const SparseMatrix stiffness = assemble_stiffness(model);
   const ImplementationScope scope(implementation);
-  StaticOptions options;
   options.solver = scope.solver();
   MechanicsOutcome out;
   std::vector<double> samples_ms;
