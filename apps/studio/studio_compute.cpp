@@ -1,6 +1,5 @@
 #include "studio/studio_compute.hpp"
 
-#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>

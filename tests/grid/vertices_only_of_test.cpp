@@ -1,6 +1,7 @@
 // vertices_only_of: the corners a set of cells owns alone, before and after a cut.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <vector>
 
 #include "cleave/core/error.hpp"

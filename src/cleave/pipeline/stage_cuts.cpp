@@ -1,8 +1,9 @@
 // Stage "cuts" of a batch run: the case's "incisions" and "cuts" sections (io/case_cuts.hpp).
 // Every request is validated before the linked volume is touched; then incisions, scalpel cuts
 // and flaps are cut in that order. Adds the cell field "removed" (1 for the cells of removed
-// plugs: cut-free pieces not displayed, which the mechanics stage holds) and summary["cut"]: counts of requests, links cut, vertices
-// split and components.
+// plugs: cut-free pieces not displayed, which the mechanics stage holds; also left in
+// ctx.removed_cells) and summary["cut"]: counts of requests, links cut, vertices split and
+// components.
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/io/case_cuts.hpp"
 #include "cleave/pipeline/stages.hpp"
