@@ -86,12 +86,13 @@ TEST(EigenvalueEdits, AValueChangeIsOneSolveAndAMoveEqualsAFreshSolve) {
                                     .eigenvalues_kPa),
             1e-10);
 
-  points[0].position_mm = Vec3(40, 30, 10);  // two diagonal entries change: CG with the kept factor
+  points[0].position_mm = Vec3(40, 30, 10);  // two diagonal entries change: the kept factor answers
   points.push_back({{60, 40, 10}, 10, 10});  // and a third
   s = interp.solve(frames, control_point_targets(m, points, tolerance_mm), EigenvalueSolver::cholesky, s.eigenvalues_kPa);
   if (interp.factorizations() == 1) {
-    EXPECT_GT(s.iterations, 0);
-    EXPECT_LE(s.iterations, 2 * 8);  // about rank + 1 per right-hand side (two non-zero ones)
+    // Exactly by the Woodbury update (no CG iteration), or by CG with the kept factor when the
+    // update's new columns were judged dearer: about rank + 1 per right-hand side (two non-zero ones).
+    EXPECT_LE(s.iterations, 2 * 8);
   } else {
     EXPECT_EQ(interp.factorizations(), 2);  // judged cheaper to refactorize: one new factor
   }

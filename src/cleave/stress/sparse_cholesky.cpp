@@ -4,6 +4,7 @@
 #include "cleave/stress/sparse_cholesky.hpp"
 
 #include <Eigen/CholmodSupport>
+#include <Eigen/LU>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -32,6 +33,13 @@ struct SparseCholesky::Impl {
   std::vector<double> values;     ///< the factorized matrix's values (pattern: outer, inner)
   double factor_seconds = 0;      ///< wall time of the last numeric factorization
   double solve_seconds = 0;       ///< wall time of one solve with the factor (one column), last measured
+  Eigen::VectorXd diagonal;       ///< the factorized matrix's diagonal
+  double column_seconds = 0;      ///< wall time per column of the last batch of Woodbury columns (0: none yet)
+  // Woodbury update: column c of low_rank_columns is a0^-1 e_r for r = low_rank_row[c] (a0 the
+  // factorized matrix); column_of_row[r] is c or -1. Emptied by every factorization.
+  Eigen::MatrixXd low_rank_columns;
+  std::vector<Eigen::Index> low_rank_row;
+  std::vector<Eigen::Index> column_of_row;
 
   bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
     if (!analyzed || static_cast<std::size_t>(a.outerSize() + 1) != outer.size()) return false;
@@ -68,7 +76,13 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   }
   impl_->factor_seconds = seconds_between(start, Clock::now());
   impl_->values.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
+  impl_->diagonal = a.diagonal();
+  impl_->low_rank_columns.resize(0, 0);
+  impl_->low_rank_row.clear();
+  impl_->column_of_row.assign(static_cast<std::size_t>(a.rows()), -1);
 }
+
+Eigen::Index SparseCholesky::low_rank_rows() const { return static_cast<Eigen::Index>(impl_->low_rank_row.size()); }
 
 bool SparseCholesky::factor_is_of(const Eigen::SparseMatrix<double>& a) const {
   if (!impl_->same_pattern(a) || impl_->values.size() != static_cast<std::size_t>(a.nonZeros())) return false;
@@ -108,6 +122,11 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
         ++changed;
         diagonal_only = diagonal_only && a.innerIndexPtr()[k] == j;
       }
+  if (diagonal_only) {
+    const Eigen::MatrixXd start = x;
+    if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds)) return true;
+    x = start;
+  }
   Eigen::Index columns = 0;
   for (Eigen::Index col = 0; col < b.cols(); ++col) columns += b.col(col).squaredNorm() > 0.0 ? 1 : 0;
   if (diagonal_only && static_cast<double>(columns) * (changed + 1) * impl_->solve_seconds > refactor_seconds) return false;
@@ -158,6 +177,70 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
     x.col(col) = xc;
   }
   return true;
+}
+
+bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+                                           double relative_tolerance, double refactor_seconds) const {
+  Impl& impl = *impl_;
+  const Eigen::Index n = a.rows();
+  const Eigen::VectorXd diagonal = a.diagonal();
+  std::vector<Eigen::Index> missing;  // changed rows without a column of G yet
+  for (Eigen::Index r = 0; r < n; ++r)
+    if (diagonal[r] != impl.diagonal[r] && impl.column_of_row[static_cast<std::size_t>(r)] < 0) missing.push_back(r);
+  const auto kept = static_cast<Eigen::Index>(impl.low_rank_row.size());
+  const Eigen::Index rows = kept + static_cast<Eigen::Index>(missing.size());
+  if (rows == 0 || rows > kMaxLowRankRows || 8.0 * static_cast<double>(n) * static_cast<double>(rows) > kMaxLowRankBytes)
+    return false;
+  // The new columns cost about their count times one column's solve (measured on the last batch
+  // of columns, or on the last solve): not more than a new factor.
+  const double column_seconds = impl.column_seconds > 0 ? impl.column_seconds : impl.solve_seconds;
+  if (static_cast<double>(missing.size()) * column_seconds > refactor_seconds) return false;
+  if (!missing.empty()) {
+    const Clock::time_point start = Clock::now();
+    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(missing.size()));
+    for (std::size_t c = 0; c < missing.size(); ++c) unit(missing[c], static_cast<Eigen::Index>(c)) = 1.0;
+    const Eigen::MatrixXd columns = impl.llt.solve(unit);
+    if (impl.llt.info() != Eigen::Success || !columns.allFinite()) return false;
+    impl.column_seconds = seconds_between(start, Clock::now()) / static_cast<double>(missing.size());
+    impl.low_rank_columns.conservativeResize(n, rows);
+    impl.low_rank_columns.rightCols(columns.cols()) = columns;
+    for (std::size_t c = 0; c < missing.size(); ++c) {
+      impl.column_of_row[static_cast<std::size_t>(missing[c])] = kept + static_cast<Eigen::Index>(c);
+      impl.low_rank_row.push_back(missing[c]);
+    }
+  }
+  // a = a0 + E D E^T over every kept row (D = 0 where a row has its factorized value again).
+  const Eigen::MatrixXd& g = impl.low_rank_columns;
+  Eigen::VectorXd d(rows);
+  for (Eigen::Index c = 0; c < rows; ++c) {
+    const Eigen::Index r = impl.low_rank_row[static_cast<std::size_t>(c)];
+    d[c] = diagonal[r] - impl.diagonal[r];
+  }
+  Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(rows, rows);  // I + D E^T G
+  for (Eigen::Index c = 0; c < rows; ++c)
+    for (Eigen::Index k = 0; k < rows; ++k) capacitance(k, c) += d[k] * g(impl.low_rank_row[static_cast<std::size_t>(k)], c);
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
+  const auto solve_updated = [&](const Eigen::MatrixXd& rhs) {
+    Eigen::MatrixXd y = impl.llt.solve(rhs);
+    Eigen::MatrixXd t(rows, rhs.cols());
+    for (Eigen::Index k = 0; k < rows; ++k) t.row(k) = d[k] * y.row(impl.low_rank_row[static_cast<std::size_t>(k)]);
+    y.noalias() -= g * lu.solve(t);
+    return y;
+  };
+  const Eigen::VectorXd b_norm = b.colwise().norm().transpose();
+  x = solve_updated(b);
+  for (int step = 0;; ++step) {
+    if (!x.allFinite()) return false;
+    const Eigen::MatrixXd r = b - a * x;
+    bool converged = true;
+    for (Eigen::Index col = 0; col < b.cols(); ++col) converged = converged && r.col(col).norm() <= relative_tolerance * b_norm[col];
+    if (converged) {
+      ++low_rank_solves_;
+      return true;
+    }
+    if (step == kLowRankRefinementSteps) return false;
+    x += solve_updated(r);
+  }
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {

@@ -38,7 +38,13 @@ class SparseCholesky {
   /// d + 1 solves per column cost more than the last factorization plus a refined solve, it does
   /// not start; otherwise, from its 4th iteration on (its (d + 2)th for a diagonal change), it
   /// projects its remaining iterations from the residual's mean rate and stops when their
-  /// measured cost exceeds that of a new factor, or when they would exceed max_iterations. Returns true when every column reached
+  /// measured cost exceeds that of a new factor, or when they would exceed max_iterations.
+  /// Before that CG, a change of diagonal entries only (a = a0 + E D E^T, E the unit columns of
+  /// the changed rows) is solved exactly with the kept factor by the Woodbury identity
+  ///   a^-1 = a0^-1 - G (I + D E^T G)^-1 D G^T,   G = a0^-1 E,
+  /// with G's columns kept across calls while the factor stays (a later edit solves only for rows
+  /// it changes first), followed by iterative refinement against `a` (see kMaxLowRankRows).
+  /// Returns true when every column reached
   /// ||b - a x|| <= relative_tolerance ||b||; false (x unspecified) when there is no factor, the
   /// pattern differs, or CG gave up: then factorize(a).
   bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
@@ -47,14 +53,29 @@ class SparseCholesky {
   bool factor_is_of(const Eigen::SparseMatrix<double>& a) const;
   /// Preconditioned CG iterations run by the last solve_with_current_factor (all columns).
   int last_iterations() const { return last_iterations_; }
+  /// Rows of a0^-1 E kept for the Woodbury update (0 after a factorization).
+  Eigen::Index low_rank_rows() const;
+  /// Calls of solve_with_current_factor answered by the Woodbury update.
+  int low_rank_solves() const { return low_rank_solves_; }
+  /// The Woodbury update is used for at most this many changed diagonal rows since the last
+  /// factorization, and while G (n x rows doubles) stays below kMaxLowRankBytes.
+  static constexpr Eigen::Index kMaxLowRankRows = 1024;
+  static constexpr double kMaxLowRankBytes = 256.0 * 1024 * 1024;
+  /// Refinement steps of the Woodbury solve (each one solve with the kept factor) before it gives up.
+  static constexpr int kLowRankRefinementSteps = 3;
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
+  /// The Woodbury update of solve_with_current_factor: true when x reached the tolerance.
+  /// Gives up (false) before solving when its new columns would cost more than refactor_seconds.
+  bool solve_diagonal_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+                             double relative_tolerance, double refactor_seconds) const;
   int reused_ = 0;
   mutable int last_iterations_ = 0;
+  mutable int low_rank_solves_ = 0;
 };
 
 }  // namespace cleave

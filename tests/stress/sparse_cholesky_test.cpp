@@ -1,0 +1,116 @@
+// The kept factor of the design systems after edits that change diagonal entries only (constraints
+// added, removed, moved): the Woodbury update must give the solution of the edited system, keep
+// its columns across edits, and give way to a factorization when it cannot reach the tolerance.
+#include <gtest/gtest.h>
+
+#include <Eigen/SparseCholesky>
+#include <vector>
+
+#include "cleave/stress/sparse_cholesky.hpp"
+
+namespace cleave {
+namespace {
+
+/// w_L L^T L of the 7-point cell Laplacian on an n x n x n block of cells, plus `constraint` on
+/// the diagonal of each constrained cell: the shape of the design's direction and eigenvalue systems.
+Eigen::SparseMatrix<double> design_system(int n, const std::vector<int>& constrained, double constraint) {
+  const int cells = n * n * n;
+  const auto id = [n](int i, int j, int k) { return i + n * (j + n * k); };
+  std::vector<Eigen::Triplet<double>> entries;
+  for (int k = 0; k < n; ++k)
+    for (int j = 0; j < n; ++j)
+      for (int i = 0; i < n; ++i) {
+        std::vector<int> neighbours;
+        if (i > 0) neighbours.push_back(id(i - 1, j, k));
+        if (i + 1 < n) neighbours.push_back(id(i + 1, j, k));
+        if (j > 0) neighbours.push_back(id(i, j - 1, k));
+        if (j + 1 < n) neighbours.push_back(id(i, j + 1, k));
+        if (k > 0) neighbours.push_back(id(i, j, k - 1));
+        if (k + 1 < n) neighbours.push_back(id(i, j, k + 1));
+        const int row = id(i, j, k);
+        entries.emplace_back(row, row, -1.0);
+        for (const int c : neighbours) entries.emplace_back(row, c, 1.0 / static_cast<double>(neighbours.size()));
+      }
+  Eigen::SparseMatrix<double> l(cells, cells);
+  l.setFromTriplets(entries.begin(), entries.end());
+  Eigen::SparseMatrix<double> a = Eigen::SparseMatrix<double>(l.transpose()) * l;
+  for (const int c : constrained) a.coeffRef(c, c) += constraint;
+  a.makeCompressed();
+  return a;
+}
+
+/// Right-hand sides w_C target at the constrained cells (two columns of different targets).
+Eigen::MatrixXd targets(int cells, const std::vector<int>& constrained, double constraint) {
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(cells, 2);
+  for (std::size_t t = 0; t < constrained.size(); ++t) {
+    b(constrained[t], 0) += constraint * (1.0 + 0.1 * static_cast<double>(t));
+    b(constrained[t], 1) += constraint * (t % 2 == 0 ? 1.0 : -0.5);
+  }
+  return b;
+}
+
+double relative_error(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference) {
+  return (x - reference).norm() / reference.norm();
+}
+
+constexpr int kSide = 12;
+constexpr int kCells = kSide * kSide * kSide;
+constexpr double kConstraint = 1e3;
+constexpr double kTolerance = 1e-13;
+
+TEST(SparseCholeskyUpdate, ConstraintsAddedRemovedAndMovedAreSolvedWithTheKeptFactor) {
+  const std::vector<int> first = {5, 100, 333, 900, 1500};
+  SparseCholesky chol;
+  const Eigen::SparseMatrix<double> a0 = design_system(kSide, first, kConstraint);
+  chol.factorize(a0);
+  Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
+
+  // Each edit is measured against the kept factor of `first`: added, removed, moved, and back.
+  const std::vector<std::vector<int>> edits = {{5, 100, 333, 900, 1500, 17, 18, 19, 20},
+                                               {5, 333, 1500, 17, 18, 19, 20},
+                                               {6, 101, 334, 901, 1501},
+                                               {5, 100, 333, 900, 1500, 6}};
+  Eigen::Index rows_before = 0;
+  for (std::size_t e = 0; e < edits.size(); ++e) {
+    SCOPED_TRACE(e);
+    const Eigen::SparseMatrix<double> a = design_system(kSide, edits[e], kConstraint);
+    const Eigen::MatrixXd b = targets(kCells, edits[e], kConstraint);
+    ASSERT_TRUE(chol.solve_with_current_factor(a, b, x, kTolerance, 40));
+    const Eigen::MatrixXd reference = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a).solve(b);
+    EXPECT_LT(relative_error(x, reference), 1e-9);
+    EXPECT_LE((b - a * x).norm(), 10 * kTolerance * b.norm());
+    EXPECT_EQ(chol.last_iterations(), 0);  // no CG: the update is exact
+    EXPECT_EQ(chol.low_rank_solves(), static_cast<int>(e) + 1);
+    EXPECT_GE(chol.low_rank_rows(), rows_before);  // columns are kept across edits
+    rows_before = chol.low_rank_rows();
+  }
+  // Rows changed by any edit since the factorization: 17-20 (first edit), 100 and 900 (second),
+  // 5, 333, 1500, 6, 101, 334, 901, 1501 (third); the last edit needed only row 6's kept column.
+  EXPECT_EQ(chol.low_rank_rows(), 14);
+
+  // A new factorization drops the kept columns.
+  chol.factorize(design_system(kSide, edits.back(), kConstraint));
+  EXPECT_EQ(chol.low_rank_rows(), 0);
+}
+
+TEST(SparseCholeskyUpdate, TooManyChangedRowsFallBackToTheCaller) {
+  std::vector<int> first = {0};
+  SparseCholesky chol;
+  const Eigen::SparseMatrix<double> a0 = design_system(kSide, first, kConstraint);
+  chol.factorize(a0);
+  Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
+  // More rows than the update keeps: the kept factor alone cannot answer at once; whatever the
+  // caller is told, a true answer must be the solution.
+  std::vector<int> many;
+  for (int c = 0; c < kCells && static_cast<Eigen::Index>(many.size()) <= SparseCholesky::kMaxLowRankRows; ++c) many.push_back(c);
+  const Eigen::SparseMatrix<double> a = design_system(kSide, many, kConstraint);
+  const Eigen::MatrixXd b = targets(kCells, many, kConstraint);
+  if (chol.solve_with_current_factor(a, b, x, kTolerance, 40)) {
+    EXPECT_LE((b - a * x).norm(), 10 * kTolerance * b.norm());
+  }
+  EXPECT_EQ(chol.low_rank_solves(), 0);
+  EXPECT_EQ(chol.low_rank_rows(), 0);
+}
+
+}  // namespace
+}  // namespace cleave
