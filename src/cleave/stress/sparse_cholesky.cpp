@@ -23,6 +23,24 @@ double seconds_between(Clock::time_point a, Clock::time_point b) { return std::c
 /// CG with the kept factor projects its remaining work from this iteration on at the earliest.
 constexpr int kFirstProjectedIteration = 4;
 
+/// Iterative refinement of a x = b with `solve` (an approximate inverse of a): true as soon as every
+/// column has ||b - a x|| <= relative_tolerance ||b||; false after `steps` corrections without that,
+/// or when x is not finite.
+template <typename Solve>
+bool refine(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x, double relative_tolerance,
+            int steps, const Solve& solve) {
+  const Eigen::VectorXd b_norm = b.colwise().norm().transpose();
+  for (int step = 0;; ++step) {
+    if (!x.allFinite()) return false;
+    const Eigen::MatrixXd r = b - a * x;
+    bool converged = true;
+    for (Eigen::Index col = 0; col < b.cols() && converged; ++col) converged = r.col(col).norm() <= relative_tolerance * b_norm[col];
+    if (converged) return true;
+    if (step == steps) return false;
+    x += solve(r);
+  }
+}
+
 }  // namespace
 
 struct SparseCholesky::Impl {
@@ -105,7 +123,9 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
   last_iterations_ = 0;
   if (!impl_->analyzed || !impl_->same_pattern(a) || x.rows() != b.rows() || x.cols() != b.cols()) return false;
   if (factor_is_of(a)) {  // only the right-hand side changed: the factor is exact
-    x = solve_refined(a, b);
+    // Refined as solve_refined does, but only until the tolerance is met (usually one step).
+    x = solve(b);
+    refine(a, b, x, relative_tolerance, kRefinementSteps, [&](const Eigen::MatrixXd& r) { return solve(r); });
     return true;
   }
   // Giving up costs a factorization and a refined solve of every column.
@@ -195,15 +215,20 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
   // of columns, or on the last solve): not more than a new factor.
   const double column_seconds = impl.column_seconds > 0 ? impl.column_seconds : impl.solve_seconds;
   if (static_cast<double>(missing.size()) * column_seconds > refactor_seconds) return false;
-  if (!missing.empty()) {
+  // y = a0^-1 b and the new columns in one solve (the factor is read once for all of them).
+  const auto new_columns = static_cast<Eigen::Index>(missing.size());
+  Eigen::MatrixXd y;
+  if (new_columns > 0) {
     const Clock::time_point start = Clock::now();
-    Eigen::MatrixXd unit = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(missing.size()));
-    for (std::size_t c = 0; c < missing.size(); ++c) unit(missing[c], static_cast<Eigen::Index>(c)) = 1.0;
-    const Eigen::MatrixXd columns = impl.llt.solve(unit);
-    if (impl.llt.info() != Eigen::Success || !columns.allFinite()) return false;
-    impl.column_seconds = seconds_between(start, Clock::now()) / static_cast<double>(missing.size());
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, new_columns + b.cols());
+    for (Eigen::Index c = 0; c < new_columns; ++c) rhs(missing[static_cast<std::size_t>(c)], c) = 1.0;
+    rhs.rightCols(b.cols()) = b;
+    const Eigen::MatrixXd solved = impl.llt.solve(rhs);
+    if (impl.llt.info() != Eigen::Success || !solved.allFinite()) return false;
+    impl.column_seconds = seconds_between(start, Clock::now()) / static_cast<double>(rhs.cols());
     impl.low_rank_columns.conservativeResize(n, rows);
-    impl.low_rank_columns.rightCols(columns.cols()) = columns;
+    impl.low_rank_columns.rightCols(new_columns) = solved.leftCols(new_columns);
+    y = solved.rightCols(b.cols());
     for (std::size_t c = 0; c < missing.size(); ++c) {
       impl.column_of_row[static_cast<std::size_t>(missing[c])] = kept + static_cast<Eigen::Index>(c);
       impl.low_rank_row.push_back(missing[c]);
@@ -220,27 +245,22 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
   for (Eigen::Index c = 0; c < rows; ++c)
     for (Eigen::Index k = 0; k < rows; ++k) capacitance(k, c) += d[k] * g(impl.low_rank_row[static_cast<std::size_t>(k)], c);
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
-  const auto solve_updated = [&](const Eigen::MatrixXd& rhs) {
-    Eigen::MatrixXd y = impl.llt.solve(rhs);
-    Eigen::MatrixXd t(rows, rhs.cols());
-    for (Eigen::Index k = 0; k < rows; ++k) t.row(k) = d[k] * y.row(impl.low_rank_row[static_cast<std::size_t>(k)]);
-    y.noalias() -= g * lu.solve(t);
-    return y;
+  // a^-1 r from y = a0^-1 r.
+  const auto update = [&](Eigen::MatrixXd& solved) {
+    Eigen::MatrixXd t(rows, solved.cols());
+    for (Eigen::Index k = 0; k < rows; ++k) t.row(k) = d[k] * solved.row(impl.low_rank_row[static_cast<std::size_t>(k)]);
+    solved.noalias() -= g * lu.solve(t);
   };
-  const Eigen::VectorXd b_norm = b.colwise().norm().transpose();
-  x = solve_updated(b);
-  for (int step = 0;; ++step) {
-    if (!x.allFinite()) return false;
-    const Eigen::MatrixXd r = b - a * x;
-    bool converged = true;
-    for (Eigen::Index col = 0; col < b.cols(); ++col) converged = converged && r.col(col).norm() <= relative_tolerance * b_norm[col];
-    if (converged) {
-      ++low_rank_solves_;
-      return true;
-    }
-    if (step == kLowRankRefinementSteps) return false;
-    x += solve_updated(r);
-  }
+  if (y.size() == 0) y = impl.llt.solve(b);
+  update(y);
+  x = std::move(y);
+  const bool converged = refine(a, b, x, relative_tolerance, kLowRankRefinementSteps, [&](const Eigen::MatrixXd& r) {
+    Eigen::MatrixXd solved = impl.llt.solve(r);
+    update(solved);
+    return solved;
+  });
+  if (converged) ++low_rank_solves_;
+  return converged;
 }
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {

@@ -29,7 +29,8 @@ class SparseCholesky {
   static constexpr int kRefinementSteps = 2;
   /// Solves a x = b for a matrix `a` with the pattern of the factorized one, starting from x (the
   /// previous solution). When `a` has exactly the values of the factorized matrix (an edit that
-  /// changed only the right-hand side) this is one refined solve with the factor. Otherwise (a
+  /// changed only the right-hand side) this is one solve with the factor, refined until the
+  /// tolerance is met (at most kRefinementSteps steps; usually one). Otherwise (a
   /// design edit changed some values) it runs conjugate gradients preconditioned with the kept
   /// factor, column by column: an edit that changes a few constraint rows is a low-rank change, so
   /// CG needs about as many iterations as the rank of the change and no new factorization is
