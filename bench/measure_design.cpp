@@ -77,6 +77,7 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
   StressDesigner designer(uncut, scenario.design);
   std::vector<double> vector_ms, value_ms, equilibrate_ms, update_ms;
   int preview_iterations = 0;
+  int equilibrate_iterations = 0;  ///< the most of any edit
   std::vector<Vec3> picture_mm;  // deformed render surface vertices: what the page draws
   // The preview's statics are kept across edits as the studio keeps them: CHOLMOD's factor of the
   // incised body (removed plugs held), made at the first edit's solve, then one forward/back
@@ -96,6 +97,7 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
     vector_ms.push_back(kMsPerSecond * t.directions_s);
     value_ms.push_back(kMsPerSecond * t.eigenvalues_s);
     equilibrate_ms.push_back(kMsPerSecond * t.equilibration_s);
+    equilibrate_iterations = std::max(equilibrate_iterations, designer.result().equilibration_iterations);
   }
   DesignOutcome out;
   out.line_tensors = frame_line_tensors(designer.result().frames);
@@ -105,6 +107,7 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
   out.value_point.time = summarize_timings(time_control_point_edits(designer, scenario, repeat));
   out.value_point.iterations = designer.result().eigenvalue_iterations;
   out.equilibrate.time = summarize_timings(equilibrate_ms);
+  out.equilibrate.iterations = equilibrate_iterations;
   out.update.time = summarize_timings(update_ms);
   out.update.iterations = preview_iterations;
   out.eigenvalues_kPa = flatten_eigenvalues(designer.result().eigenvalues_kPa);

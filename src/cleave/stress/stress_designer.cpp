@@ -112,9 +112,12 @@ void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
   const auto start = std::chrono::steady_clock::now();
   if (design.equilibration == Equilibration::growth) {
     if (!ops_->equilibrator) ops_->equilibrator = std::make_unique<StressEquilibrator>(model_, ops_->held_vertices);
-    out.stress_kPa = ops_->equilibrator->equilibrate(out.designed_kPa).stress_kPa;
+    EquilibrationResult balanced = ops_->equilibrator->equilibrate(out.designed_kPa);
+    out.stress_kPa = std::move(balanced.stress_kPa);
+    out.equilibration_iterations = balanced.refinement_steps;
   } else {
     out.stress_kPa = out.designed_kPa;
+    out.equilibration_iterations = 0;
   }
   out.timings.equilibration_s = seconds_since(start);
   out.residual_final = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.stress_kPa);

@@ -47,6 +47,7 @@ struct DesignResult {
   double residual_final = 0;             ///< the same of stress_kPa
   int eigenvalue_iterations = 0;         ///< CG iterations of the last eigenvalue solve (paper CG; for the default, CG
                                          ///< with the kept factor, 0 = direct solve or not redone)
+  int equilibration_iterations = 0;      ///< CG iterations of the last equilibration (0 = none or already balanced)
   DesignTimings timings;
 };
 
