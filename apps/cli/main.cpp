@@ -4,6 +4,7 @@
 #include <cstdio>
 #include <exception>
 
+#include "cleave/core/allocator_tuning.hpp"
 #include "cleave/core/error.hpp"
 #include "command_registry.hpp"
 
@@ -17,6 +18,7 @@ std::vector<Command>& command_registry() {
 }  // namespace cleave::cli
 
 int main(int argc, char** argv) {
+  cleave::keep_freed_memory_for_reuse();  // before any thread: solvers reallocate the same large arrays
   using namespace cleave::cli;
   CLI::App app{"cleave " CLEAVE_VERSION
                ": interactive residual-stress modelling and cut simulation of soft tissue\n"
