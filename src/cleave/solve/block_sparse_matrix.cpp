@@ -4,7 +4,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
-#include <iterator>
+#include <cstddef>
 
 namespace cleave {
 namespace {
@@ -41,42 +41,88 @@ void fill_block_row(const SparseMatrix& a, Eigen::Index v, BlockSparseMatrix<Sca
 
 }  // namespace
 
+namespace {
+
+/// Whether the CSR rows 3v..3v+2 have the vertex-block pattern: the same columns in each, made of
+/// whole triples (3w, 3w+1, 3w+2), as every matrix the finite elements and the Galerkin products
+/// assemble. Such a block row's blocks are read straight off the CSR.
+bool is_vertex_block_row(const SparseMatrix& a, Eigen::Index v) {
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  const auto begin = outer[3 * v];
+  const auto length = outer[3 * v + 1] - begin;
+  if (length % 3 != 0 || outer[3 * v + 2] - outer[3 * v + 1] != length || outer[3 * v + 3] - outer[3 * v + 2] != length)
+    return false;
+  for (auto k = begin; k < begin + length; k += 3)
+    if (inner[k] % 3 != 0 || inner[k + 1] != inner[k] + 1 || inner[k + 2] != inner[k] + 2) return false;
+  return std::equal(inner + begin, inner + begin + length, inner + outer[3 * v + 1]) &&
+         std::equal(inner + begin, inner + begin + length, inner + outer[3 * v + 2]);
+}
+
+/// The sorted block columns of any block row (the three rows' columns / 3, merged).
+void merged_block_columns(const SparseMatrix& a, Eigen::Index v, std::vector<std::int32_t>& columns) {
+  const auto* outer = a.outerIndexPtr();
+  const auto* inner = a.innerIndexPtr();
+  columns.clear();
+  for (int i = 0; i < 3; ++i)
+    for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) columns.push_back(inner[k] / 3);
+  std::sort(columns.begin(), columns.end());
+  columns.erase(std::unique(columns.begin(), columns.end()), columns.end());
+}
+
+}  // namespace
+
 template <typename Scalar>
 BlockSparseMatrix<Scalar> to_block_sparse(const SparseMatrix& a) {
   BlockSparseMatrix<Scalar> b;
   const Eigen::Index n = a.rows() / 3;
   const auto* outer = a.outerIndexPtr();
   const auto* inner = a.innerIndexPtr();
-  std::vector<std::vector<std::int32_t>> columns(static_cast<std::size_t>(n));
-  for_each_block_row(n, [&](Eigen::Index v) {
-    auto& c = columns[static_cast<std::size_t>(v)];
-    // Sorted rows: the block columns of one row come out sorted; the three rows of a vertex
-    // usually have the same ones (the vertex-block pattern), and only otherwise are merged.
-    const auto row_blocks = [&](int i, std::vector<std::int32_t>& out) {
-      out.clear();
-      for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k)
-        if (out.empty() || out.back() != inner[k] / 3) out.push_back(inner[k] / 3);
-    };
-    row_blocks(0, c);
-    std::vector<std::int32_t> other;
-    for (int i = 1; i < 3; ++i) {
-      row_blocks(i, other);
-      if (other == c) continue;
-      std::vector<std::int32_t> merged;
-      std::set_union(c.begin(), c.end(), other.begin(), other.end(), std::back_inserter(merged));
-      c.swap(merged);
+  const double* values = a.valuePtr();
+  // Pass 1: blocks per block row; rows of the vertex-block pattern (all, in practice) need no
+  // scratch, the others merge their three rows' columns.
+  std::vector<std::uint8_t> vertex_block(static_cast<std::size_t>(n));
+  b.row_start.assign(static_cast<std::size_t>(n) + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, kBlockRowsPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    std::vector<std::int32_t> scratch;
+    for (Eigen::Index v = r.begin(); v < r.end(); ++v) {
+      const auto row = static_cast<std::size_t>(v);
+      vertex_block[row] = is_vertex_block_row(a, v) ? 1 : 0;
+      if (vertex_block[row]) {
+        b.row_start[row + 1] = static_cast<std::int32_t>((outer[3 * v + 1] - outer[3 * v]) / 3);
+      } else {
+        merged_block_columns(a, v, scratch);
+        b.row_start[row + 1] = static_cast<std::int32_t>(scratch.size());
+      }
     }
   });
-  b.row_start.assign(static_cast<std::size_t>(n) + 1, 0);
-  for (Eigen::Index v = 0; v < n; ++v)
-    b.row_start[static_cast<std::size_t>(v) + 1] =
-        b.row_start[static_cast<std::size_t>(v)] + static_cast<std::int32_t>(columns[static_cast<std::size_t>(v)].size());
+  for (std::size_t v = 0; v < static_cast<std::size_t>(n); ++v) b.row_start[v + 1] += b.row_start[v];
   b.column.resize(static_cast<std::size_t>(b.row_start.back()));
   b.values.resize(9 * b.column.size());
-  for_each_block_row(n, [&](Eigen::Index v) {
-    std::copy(columns[static_cast<std::size_t>(v)].begin(), columns[static_cast<std::size_t>(v)].end(),
-              b.column.begin() + b.row_start[static_cast<std::size_t>(v)]);
-    fill_block_row(a, v, b);
+  // Pass 2: columns and values.
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, n, kBlockRowsPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    std::vector<std::int32_t> scratch;
+    for (Eigen::Index v = r.begin(); v < r.end(); ++v) {
+      const auto row = static_cast<std::size_t>(v);
+      const auto first = static_cast<std::size_t>(b.row_start[row]);
+      if (!vertex_block[row]) {
+        merged_block_columns(a, v, scratch);
+        std::copy(scratch.begin(), scratch.end(), b.column.begin() + static_cast<std::ptrdiff_t>(first));
+        fill_block_row(a, v, b);
+        continue;
+      }
+      const auto blocks = static_cast<std::size_t>(b.row_start[row + 1]) - first;
+      for (std::size_t j = 0; j < blocks; ++j) b.column[first + j] = inner[outer[3 * v] + static_cast<Eigen::Index>(3 * j)] / 3;
+      for (int i = 0; i < 3; ++i) {
+        const double* source = values + outer[3 * v + i];
+        Scalar* target = b.values.data() + 9 * first + 3 * static_cast<std::size_t>(i);
+        for (std::size_t j = 0; j < blocks; ++j, source += 3, target += 9) {
+          target[0] = static_cast<Scalar>(source[0]);
+          target[1] = static_cast<Scalar>(source[1]);
+          target[2] = static_cast<Scalar>(source[2]);
+        }
+      }
+    }
   });
   return b;
 }
