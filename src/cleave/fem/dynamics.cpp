@@ -56,7 +56,6 @@ void Dynamics::rebuild_topology() {
     const auto* end = system_.innerIndexPtr() + system_.outerIndexPtr()[row + 1];
     diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - system_.innerIndexPtr();
   }
-  solver_ready_ = false;  // new pattern: the next step sets the solver up afresh
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
   update_rotations();
 }
@@ -79,6 +78,7 @@ void Dynamics::topology_changed(const CutReport& report) {
     settings_.external_force_mN.conservativeResize(dofs);
     settings_.external_force_mN.tail(dofs - old).setZero();
   }
+  note_vertex_origins(report);
   for (const VertexSplit& split : report.splits)
     for (const VertexId v : split.created) {
       u_.segment<3>(3 * v) = u_.segment<3>(3 * split.original);
@@ -93,6 +93,18 @@ void Dynamics::topology_changed(const CutReport& report) {
   // motion of the new topology; the old one (copied onto split vertices) would inject momentum
   // (a cell cut loose under 20 kPa left at 5 m/s instead of staying in place).
   compute_acceleration();
+}
+
+void Dynamics::note_vertex_origins(const CutReport& report) {
+  const VertexId count = model_.volume.vertex_count();
+  origin_of_new_.resize(static_cast<std::size_t>(std::max<VertexId>(count - solver_vertices_, 0)), kNone);
+  for (const VertexSplit& split : report.splits)
+    for (const VertexId v : split.created)
+      if (v >= solver_vertices_ && v < count) origin_of_new_[static_cast<std::size_t>(v - solver_vertices_)] = split.original;
+  // A copy of a copy (two cuts through one corner before a step) goes back to the first origin.
+  for (VertexId& origin : origin_of_new_)
+    for (int hops = 0; origin >= solver_vertices_ && hops < static_cast<int>(origin_of_new_.size()); ++hops)
+      origin = origin_of_new_[static_cast<std::size_t>(origin - solver_vertices_)];
 }
 
 void Dynamics::set_state(const Vector& displacement_mm, const Vector& velocity_mm_per_s) {
@@ -240,13 +252,22 @@ SolveReport Dynamics::step(double dt) {
   } else {
     // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
     // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
-    if (solver_ready_ && c_mass == solver_mass_factor_) {
-      solver_->update_values(system_, model_.volume);
+    // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
+    // LinearSolver::update_topology) unless a divided vertex's origin is unknown.
+    const VertexId vertices = model_.volume.vertex_count();
+    const bool origins_known = std::none_of(origin_of_new_.begin(), origin_of_new_.end(),
+                                            [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
+                               static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
+    if (solver_ready_ && c_mass == solver_mass_factor_ && origins_known) {
+      if (origin_of_new_.empty()) solver_->update_values(system_, model_.volume);
+      else solver_->update_topology(system_, model_.volume, origin_of_new_);
     } else {
       solver_->setup(system_, model_.volume);
       solver_ready_ = true;
       solver_mass_factor_ = c_mass;
     }
+    solver_vertices_ = vertices;
+    origin_of_new_.clear();
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

@@ -96,6 +96,8 @@ class Dynamics {
 
  private:
   void rebuild_topology();
+  /// Records, for every vertex the cut created, the vertex the solver knew it as (origin_of_new_).
+  void note_vertex_origins(const CutReport& report);
   void update_rotations();
   /// f_int + beta_k K_R v: the elastic and residual stress forces and, with stiffness damping, the
   /// damping force of `velocity` from the same per-cell pass (K_R is never assembled for it).
@@ -116,7 +118,11 @@ class Dynamics {
   SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; vertex block pattern of the topology
   std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
   bool any_fixed_ = false;
-  bool solver_ready_ = false;  ///< set up on the current pattern (later steps only update values)
+  bool solver_ready_ = false;  ///< set up (later steps update values, or the topology after a cut)
+  VertexId solver_vertices_ = 0;  ///< vertex count of the topology the solver last saw
+  /// Per vertex created by cuts since then (id solver_vertices_ + i): the vertex it was copied
+  /// from, as the solver knew it (kNone: unknown, the solver is set up afresh).
+  std::vector<VertexId> origin_of_new_;
   double solver_mass_factor_ = 0;  ///< c_m of the matrix the solver was set up with (1/s^2)
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;

@@ -53,6 +53,16 @@ class LinearSolver {
   /// when its iterations grow: a stale preconditioner still gives the exact solution).
   /// The default sets up from scratch.
   virtual void update_values(const SparseMatrix& a, const LinkedVolume& topology) { setup(a, topology); }
+  /// Like update_values() after cuts divided vertices: `a` is the matrix of the new topology, in
+  /// which vertex `n + i` (n = the vertex count of the last setup) is a copy of vertex
+  /// `origin_of_new[i]` (< n) and every other vertex keeps its id. The cells' element matrices are unchanged by a cut, so with the prolongation
+  /// rows of each copy taken from its origin the kept coarse levels are exactly the Galerkin
+  /// operators of the new matrix (P'^T A' P' = P^T A P); only the fine level is rebuilt. The
+  /// default sets up from scratch.
+  virtual void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) {
+    (void)origin_of_new;
+    setup(a, topology);
+  }
   /// Solves A x = b; x holds the initial guess on entry (warm start) and the solution on exit.
   /// Never leaves NaN in x: on divergence x keeps its last finite iterate and converged = false.
   virtual SolveReport solve(const Vector& b, Vector& x) = 0;

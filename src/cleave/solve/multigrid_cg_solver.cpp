@@ -48,6 +48,20 @@ class MultigridCgSolver final : public LinearSolver {
     topology_ = &topology;
   }
 
+  void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) override {
+    const Eigen::Index expected_rows = a_.rows() + 3 * static_cast<Eigen::Index>(origin_of_new.size());
+    if (preconditioner_.levels().size() < 2 || a.rows() != expected_rows || !a.isCompressed() || rebuild_requested_ ||
+        stale_updates_ >= options_.max_stale_updates) {
+      setup(a, topology);
+      return;
+    }
+    a_ = a;
+    a_blocks_ = to_block_sparse<double>(a_);
+    preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
+    ++stale_updates_;
+    topology_ = &topology;
+  }
+
   SolveReport solve(const Vector& b, Vector& x) override {
     if (b.size() != a_.rows())
       throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));

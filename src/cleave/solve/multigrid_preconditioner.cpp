@@ -184,6 +184,78 @@ void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>
                     });
 }
 
+namespace {
+
+BlockSparseMatrix<float> single_precision_copy(const BlockSparseMatrix<double>& a) {
+  BlockSparseMatrix<float> b;
+  b.row_start = a.row_start;
+  b.column = a.column;
+  b.values.resize(a.values.size());
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.values.size(), std::size_t{1} << 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) b.values[i] = static_cast<float>(a.values[i]);
+                    });
+  return b;
+}
+
+/// by_coarse from by_fine (fine vertices ascending within each coarse vertex).
+void transpose_prolongation(Prolongation& p) {
+  const auto coarse = static_cast<std::size_t>(p.coarse_count());
+  p.coarse_start.assign(coarse + 1, 0);
+  for (const Prolongation::Entry& e : p.by_fine) ++p.coarse_start[static_cast<std::size_t>(e.vertex) + 1];
+  for (std::size_t c = 0; c < coarse; ++c) p.coarse_start[c + 1] += p.coarse_start[c];
+  p.by_coarse.resize(p.by_fine.size());
+  std::vector<int> next(p.coarse_start.begin(), p.coarse_start.end() - 1);
+  for (VertexId f = 0; f < p.fine_count(); ++f)
+    for (int k = p.fine_start[static_cast<std::size_t>(f)]; k < p.fine_start[static_cast<std::size_t>(f) + 1]; ++k) {
+      const Prolongation::Entry& e = p.by_fine[static_cast<std::size_t>(k)];
+      p.by_coarse[static_cast<std::size_t>(next[static_cast<std::size_t>(e.vertex)]++)] = {f, e.weight};
+    }
+}
+
+}  // namespace
+
+void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
+                                                 const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
+  if (levels_.size() < 2) throw InputError("multigrid: a single-level hierarchy has no fine level to replace; set it up afresh");
+  MultigridLevel& fine = levels_[0];
+  Prolongation& p = fine.from_coarser;
+  const VertexId old_count = p.fine_count();
+  const auto copies = static_cast<VertexId>(origin_of_new.size());
+  if (a.rows() != 3 * static_cast<Eigen::Index>(old_count + copies) || blocks.rows() != a.rows())
+    throw InputError(fmt::format("multigrid: the new fine matrix has {} rows; expected {} ({} vertices and {} copies, 3 dofs each)",
+                                 a.rows(), 3 * (old_count + copies), old_count, copies));
+  p.by_fine.reserve(p.by_fine.size() + 8 * origin_of_new.size());
+  for (const VertexId origin : origin_of_new) {
+    if (origin < 0 || origin >= old_count)
+      throw InputError(fmt::format("multigrid: a divided vertex's origin is {}; expected a vertex of the old fine level (0 to {})",
+                                   origin, old_count - 1));
+    for (int k = p.fine_start[static_cast<std::size_t>(origin)]; k < p.fine_start[static_cast<std::size_t>(origin) + 1]; ++k) {
+      const Prolongation::Entry entry = p.by_fine[static_cast<std::size_t>(k)];
+      p.by_fine.push_back(entry);
+    }
+    p.fine_start.push_back(static_cast<int>(p.by_fine.size()));
+  }
+  transpose_prolongation(p);
+  fine_ = &a;
+  fine.fixed = identity_rows(a);
+  if (precision_ == CyclePrecision::single_precision) {
+    fine.single.blocks = single_precision_copy(blocks);
+    fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother);
+    const auto n = a.rows();
+    fine.single.rhs.setZero(n);
+    fine.single.solution.setZero(n);
+    fine.single.residual.setZero(n);
+  } else {
+    fine.twin.blocks = blocks;
+    fine.smoother = make_chebyshev_smoother(fine.twin.blocks, smoother);
+    const auto n = a.rows();
+    fine.twin.rhs.setZero(n);
+    fine.twin.solution.setZero(n);
+    fine.twin.residual.setZero(n);
+  }
+}
+
 template <typename Scalar>
 void MultigridPreconditioner::cycle(std::size_t l) const {
   const MultigridLevel& level = levels_[l];

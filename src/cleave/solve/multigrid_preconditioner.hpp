@@ -99,6 +99,15 @@ class MultigridPreconditioner final : public Preconditioner {
   /// matrix, and so does operator_of(0).
   void refresh_fine_level(const BlockSparseMatrix<double>& a);
 
+  /// Replaces the fine level after cuts divided vertices (LinearSolver::update_topology): `a` is
+  /// the new fine matrix (kept referenced, like the one built from), `blocks` the same as block
+  /// CSR, vertex `n + i` of it a copy of the old fine vertex `origin_of_new[i]`. Each copy gets
+  /// its origin's prolongation row; the fine level's fixed dofs, block diagonal and eigenvalue
+  /// bound are those of `a`; the coarse levels and the coarsest factorization stay. Needs at
+  /// least two levels (throws InputError otherwise, and for origins or sizes that do not fit).
+  void replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
+                          const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother);
+
   /// Level 0 is the fine level; the last level is solved directly.
   const std::vector<MultigridLevel>& levels() const { return levels_; }
   /// The operator of a level (level 0: the referenced fine matrix).
