@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
-# Builds the library and the C++ tests with ASan + UBSan (preset `asan`) and runs them.
-# Browser tests are left to the release pass (they exercise the same server code through the CLI).
+# Builds the library, the C++ tests and the fuzz targets with ASan + UBSan (preset `asan`, clang)
+# and runs the tests, the fuzz targets' corpus replays among them; scripts/fuzz.sh then fuzzes with
+# the same build. Browser tests are left to the release pass (they exercise the same server code
+# through the CLI).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 scripts/install-deps.sh
