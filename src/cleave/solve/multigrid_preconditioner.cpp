@@ -88,6 +88,42 @@ void restrict_to_coarse(const Prolongation& p, const std::vector<std::uint8_t>& 
   restrict_to_coarse_any(p, fine_fixed, fine, coarse);
 }
 
+namespace {
+
+/// Writes `values` rounded to float into `single` (same length).
+void round_to_single(const std::vector<double>& values, std::vector<float>& single) {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, values.size(), std::size_t{1} << 16),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t i = range.begin(); i < range.end(); ++i) single[i] = static_cast<float>(values[i]);
+                    });
+}
+
+BlockSparseMatrix<float> single_precision_copy(const BlockSparseMatrix<double>& a) {
+  BlockSparseMatrix<float> b;
+  b.row_start = a.row_start;
+  b.column = a.column;
+  b.values.resize(a.values.size());
+  round_to_single(a.values, b.values);
+  return b;
+}
+
+/// by_coarse from by_fine (fine vertices ascending within each coarse vertex).
+void transpose_prolongation(Prolongation& p) {
+  const auto coarse = static_cast<std::size_t>(p.coarse_count());
+  p.coarse_start.assign(coarse + 1, 0);
+  for (const Prolongation::Entry& e : p.by_fine) ++p.coarse_start[static_cast<std::size_t>(e.vertex) + 1];
+  for (std::size_t c = 0; c < coarse; ++c) p.coarse_start[c + 1] += p.coarse_start[c];
+  p.by_coarse.resize(p.by_fine.size());
+  std::vector<int> next(p.coarse_start.begin(), p.coarse_start.end() - 1);
+  for (VertexId f = 0; f < p.fine_count(); ++f)
+    for (int k = p.fine_start[static_cast<std::size_t>(f)]; k < p.fine_start[static_cast<std::size_t>(f) + 1]; ++k) {
+      const Prolongation::Entry& e = p.by_fine[static_cast<std::size_t>(k)];
+      p.by_coarse[static_cast<std::size_t>(next[static_cast<std::size_t>(e.vertex)]++)] = {f, e.weight};
+    }
+}
+
+}  // namespace
+
 MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options) {
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (a.rows() != dofs || a.cols() != dofs)
@@ -177,43 +213,8 @@ void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>
     fine.twin.blocks.values = a.values;
     return;
   }
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.values.size(), std::size_t{1} << 16),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i < range.end(); ++i)
-                        fine.single.blocks.values[i] = static_cast<float>(a.values[i]);
-                    });
+  round_to_single(a.values, fine.single.blocks.values);
 }
-
-namespace {
-
-BlockSparseMatrix<float> single_precision_copy(const BlockSparseMatrix<double>& a) {
-  BlockSparseMatrix<float> b;
-  b.row_start = a.row_start;
-  b.column = a.column;
-  b.values.resize(a.values.size());
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, a.values.size(), std::size_t{1} << 16),
-                    [&](const tbb::blocked_range<std::size_t>& range) {
-                      for (std::size_t i = range.begin(); i < range.end(); ++i) b.values[i] = static_cast<float>(a.values[i]);
-                    });
-  return b;
-}
-
-/// by_coarse from by_fine (fine vertices ascending within each coarse vertex).
-void transpose_prolongation(Prolongation& p) {
-  const auto coarse = static_cast<std::size_t>(p.coarse_count());
-  p.coarse_start.assign(coarse + 1, 0);
-  for (const Prolongation::Entry& e : p.by_fine) ++p.coarse_start[static_cast<std::size_t>(e.vertex) + 1];
-  for (std::size_t c = 0; c < coarse; ++c) p.coarse_start[c + 1] += p.coarse_start[c];
-  p.by_coarse.resize(p.by_fine.size());
-  std::vector<int> next(p.coarse_start.begin(), p.coarse_start.end() - 1);
-  for (VertexId f = 0; f < p.fine_count(); ++f)
-    for (int k = p.fine_start[static_cast<std::size_t>(f)]; k < p.fine_start[static_cast<std::size_t>(f) + 1]; ++k) {
-      const Prolongation::Entry& e = p.by_fine[static_cast<std::size_t>(k)];
-      p.by_coarse[static_cast<std::size_t>(next[static_cast<std::size_t>(e.vertex)]++)] = {f, e.weight};
-    }
-}
-
-}  // namespace
 
 void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
                                                  const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
@@ -242,17 +243,11 @@ void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const Bl
   if (precision_ == CyclePrecision::single_precision) {
     fine.single.blocks = single_precision_copy(blocks);
     fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother);
-    const auto n = a.rows();
-    fine.single.rhs.setZero(n);
-    fine.single.solution.setZero(n);
-    fine.single.residual.setZero(n);
+    allocate_cycle<float>();
   } else {
     fine.twin.blocks = blocks;
     fine.smoother = make_chebyshev_smoother(fine.twin.blocks, smoother);
-    const auto n = a.rows();
-    fine.twin.rhs.setZero(n);
-    fine.twin.solution.setZero(n);
-    fine.twin.residual.setZero(n);
+    allocate_cycle<double>();
   }
 }
 
