@@ -3,7 +3,7 @@
 # failed (tests/fuzz/regressions/). The targets come from the `asan` preset (clang + ASan + UBSan +
 # libFuzzer coverage), the same instrumented build that scripts/test-sanitizers.sh tests, so CI
 # compiles the library once for both. Any crash fails the run and leaves the input in
-# build/asan/fuzz-crashes/. Leaks inside teem's own error paths are suppressed (tests/fuzz/lsan.supp).
+# build/asan/fuzz-runs/crashes/. Leaks inside teem's own error paths are suppressed (tests/fuzz/lsan.supp).
 # Each input may take at most 10 s (a slow input is a finding too), and each target is stopped
 # 60 s past its budget whatever happens, so the run's length is bounded.
 # Usage: scripts/fuzz.sh [--seconds N]   (default 20 s per target)

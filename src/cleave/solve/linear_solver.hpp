@@ -55,10 +55,10 @@ class LinearSolver {
   virtual void update_values(const SparseMatrix& a, const LinkedVolume& topology) { setup(a, topology); }
   /// Like update_values() after cuts divided vertices: `a` is the matrix of the new topology, in
   /// which vertex `n + i` (n = the vertex count of the last setup) is a copy of vertex
-  /// `origin_of_new[i]` (< n) and every other vertex keeps its id. The cells' element matrices are unchanged by a cut, so with the prolongation
-  /// rows of each copy taken from its origin the kept coarse levels are exactly the Galerkin
-  /// operators of the new matrix (P'^T A' P' = P^T A P); only the fine level is rebuilt. The
-  /// default sets up from scratch.
+  /// `origin_of_new[i]` (< n) and every other vertex keeps its id. A cut leaves the cells'
+  /// element matrices unchanged, so with each copy's prolongation row taken from its origin the
+  /// multigrid's kept coarse levels are exactly the Galerkin operators of the new matrix
+  /// (P'^T A' P' = P^T A P); it rebuilds only its fine level. The default sets up from scratch.
   virtual void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) {
     (void)origin_of_new;
     setup(a, topology);
