@@ -191,12 +191,12 @@ const DesignResult* StudioCompute::design_fields(const DesignState& design, nloh
     if (!langer_only_) {
       langer_only_ = std::make_unique<LineFieldInterpolator>(model.volume, stress_design.weights);
       LineFieldInterpolator normal_interp(model.volume, stress_design.weights);
-      normal_tensors_ = normal_interp.interpolate(surface_normal_targets(model));
+      normal_axes_ = normal_axes(normal_interp.interpolate(surface_normal_targets(model)));
     }
     const double tolerance_mm = stress_design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
     const std::vector<LineTarget> targets = stroke_line_targets(model, stress_design.strokes, tolerance_mm);
     directions_only_ = DesignResult{};
-    directions_only_.frames = direction_frames(langer_only_->interpolate(targets), normal_tensors_);
+    directions_only_.frames = direction_frames(langer_only_->interpolate(targets), normal_axes_);
   } catch (const InputError& err) {
     message["design_error"] = err.what();
     return nullptr;

@@ -64,9 +64,9 @@ class StudioCompute {
   std::vector<RoundIncision> preview_incisions_;      ///< the round-incision preview (paper fig. 5)
   std::unique_ptr<StressDesigner> designer_;
   /// Directions without magnitudes (strokes but no control point yet): the Langer interpolation
-  /// and the surface normal tensors, built on first use.
+  /// and the surface normals (normal_axes of the interpolated normal field), built on first use.
   std::unique_ptr<LineFieldInterpolator> langer_only_;
-  std::vector<Mat3> normal_tensors_;
+  std::vector<Vec3> normal_axes_;
   DesignResult directions_only_;
   SparseMatrix divergence_;                           ///< T of the uncut model, for the residual display
   std::string cut_key_;                               ///< what preview_model_ was cut with

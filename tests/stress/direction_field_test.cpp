@@ -4,6 +4,7 @@
 
 #include <fmt/format.h>
 #include <limits>
+#include <string>
 
 #include "cleave/core/error.hpp"
 
@@ -74,6 +75,41 @@ TEST(DirectionField, FramesAreOrthonormalAndRightHanded) {
     ASSERT_LT((q.transpose() * q - Mat3::Identity()).norm(), 1e-12);
     ASSERT_NEAR(q.determinant(), 1.0, 1e-12);
   }
+}
+
+TEST(DirectionField, FramesFromKeptNormalAxesEqualFramesFromTheNormalTensors) {
+  // The designer keeps normal_axes(normal tensors) and rebuilds only the Langer part after a
+  // stroke edit: the frames must be the very same, also where a tensor carries no direction.
+  const TissueModel m = test::builtin_model("cylinder");
+  const double z_mid = m.volume.grid().origin_mm.z() + 0.5 * m.volume.grid().extent_mm().z();
+  const DesignWeights w;
+  LineFieldInterpolator langer(m.volume, w);
+  LineFieldInterpolator normal(m.volume, w);
+  std::vector<Mat3> langer_tensors =
+      langer.interpolate(stroke_line_targets(m, {test::circumferential_stroke(m, z_mid)}, 2.0 * m.volume.grid().cell_size_mm));
+  std::vector<Mat3> normal_tensors = normal.interpolate(surface_normal_targets(m));
+  normal_tensors[0] = Mat3::Zero();  // no normal: the Langer tensor's weakest axis
+  normal_tensors[1] = Mat3::Zero();
+  langer_tensors[1] = Mat3::Zero();  // neither: the fixed axes
+  const std::vector<Vec3> axes = normal_axes(normal_tensors);
+  EXPECT_EQ(axes[0], Vec3::Zero());
+  const std::vector<DirectionFrame> from_tensors = direction_frames(langer_tensors, normal_tensors);
+  const std::vector<DirectionFrame> from_axes = direction_frames(langer_tensors, axes);
+  ASSERT_EQ(from_axes.size(), from_tensors.size());
+  for (std::size_t c = 0; c < from_axes.size(); ++c) {
+    ASSERT_EQ(from_axes[c].langer, from_tensors[c].langer) << "cell " << c;
+    ASSERT_EQ(from_axes[c].cross, from_tensors[c].cross) << "cell " << c;
+    ASSERT_EQ(from_axes[c].normal, from_tensors[c].normal) << "cell " << c;
+  }
+  EXPECT_EQ(from_axes[1].normal, Vec3::UnitZ());
+  std::string message;
+  try {
+    direction_frames(langer_tensors, std::vector<Vec3>(3));
+  } catch (const InputError& e) {
+    message = e.what();
+  }
+  EXPECT_EQ(message, fmt::format("direction frames got {} Langer tensors and 3 normal axes; expected one of each per cell",
+                                 langer_tensors.size()));
 }
 
 TEST(DirectionField, ReversingAnySubsetOfStrokesGivesTheSameField) {

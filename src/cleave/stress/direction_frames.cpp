@@ -24,15 +24,19 @@ Vec3 any_orthogonal(const Vec3& n) {
   return t.normalized();
 }
 
-}  // namespace
-
-DirectionFrame direction_frame(const Mat3& langer_tensor, const Mat3& normal_tensor) {
-  DirectionFrame frame;
+/// The principal eigenvector of a normal tensor, zero when it carries no direction.
+Vec3 normal_axis(const Mat3& normal_tensor) {
   Eigen::SelfAdjointEigenSolver<Mat3> normal_eig;
   normal_eig.computeDirect(0.5 * (normal_tensor + normal_tensor.transpose()));
+  return normal_eig.eigenvalues()[2] > kNoDirection ? Vec3(normal_eig.eigenvectors().col(2)) : Vec3::Zero();
+}
+
+/// The frame about the normal axis `axis` (zero: none; the Langer tensor's weakest axis then).
+DirectionFrame frame_about(const Mat3& langer_tensor, const Vec3& axis) {
+  DirectionFrame frame;
   Vec3 n = Vec3::UnitZ();
-  if (normal_eig.eigenvalues()[2] > kNoDirection) {
-    n = normal_eig.eigenvectors().col(2);
+  if (axis != Vec3::Zero()) {
+    n = axis;
   } else {
     Eigen::SelfAdjointEigenSolver<Mat3> langer_eig;
     langer_eig.computeDirect(0.5 * (langer_tensor + langer_tensor.transpose()));
@@ -53,17 +57,45 @@ DirectionFrame direction_frame(const Mat3& langer_tensor, const Mat3& normal_ten
   return frame;
 }
 
-std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Mat3>& normal_tensors) {
-  if (langer_tensors.size() != normal_tensors.size())
-    throw InputError(fmt::format("direction frames got {} Langer and {} normal tensors; expected one of each per cell",
-                                 langer_tensors.size(), normal_tensors.size()));
-  std::vector<DirectionFrame> frames(langer_tensors.size());
-  tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t c) { frames[c] = direction_frame(langer_tensors[c], normal_tensors[c]); });
+void check_frames_finite(const std::vector<DirectionFrame>& frames) {
   for (std::size_t c = 0; c < frames.size(); ++c)
     if (!frames[c].langer.allFinite() || !frames[c].cross.allFinite() || !frames[c].normal.allFinite())
       throw ComputeError(fmt::format("direction frames: the frame of cell {} is not finite; expected finite Langer and normal "
                                      "tensors",
                                      c));
+}
+
+void check_one_per_cell(std::size_t langer, std::size_t normal, const char* what) {
+  if (langer != normal)
+    throw InputError(
+        fmt::format("direction frames got {} Langer tensors and {} normal {}; expected one of each per cell", langer, normal, what));
+}
+
+}  // namespace
+
+DirectionFrame direction_frame(const Mat3& langer_tensor, const Mat3& normal_tensor) {
+  return frame_about(langer_tensor, normal_axis(normal_tensor));
+}
+
+std::vector<Vec3> normal_axes(const std::vector<Mat3>& normal_tensors) {
+  std::vector<Vec3> axes(normal_tensors.size());
+  tbb::parallel_for(std::size_t{0}, axes.size(), [&](std::size_t c) { axes[c] = normal_axis(normal_tensors[c]); });
+  return axes;
+}
+
+std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Mat3>& normal_tensors) {
+  check_one_per_cell(langer_tensors.size(), normal_tensors.size(), "tensors");
+  std::vector<DirectionFrame> frames(langer_tensors.size());
+  tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t c) { frames[c] = direction_frame(langer_tensors[c], normal_tensors[c]); });
+  check_frames_finite(frames);
+  return frames;
+}
+
+std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Vec3>& normal_axes) {
+  check_one_per_cell(langer_tensors.size(), normal_axes.size(), "axes");
+  std::vector<DirectionFrame> frames(langer_tensors.size());
+  tbb::parallel_for(std::size_t{0}, frames.size(), [&](std::size_t c) { frames[c] = frame_about(langer_tensors[c], normal_axes[c]); });
+  check_frames_finite(frames);
   return frames;
 }
 

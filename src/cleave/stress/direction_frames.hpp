@@ -4,6 +4,8 @@
 // the cross direction is their cross product.
 //
 //   std::vector<DirectionFrame> f = direction_frames(langer_tensors, normal_tensors);
+//   const std::vector<Vec3> axes = normal_axes(normal_tensors);   // once: the normals never change
+//   f = direction_frames(edited_langer_tensors, axes);            // the same frames, one eigen solve less
 //
 // n = principal eigenvector of the normal tensor; t = principal eigenvector of P T P with
 // P = I - n n^T. Where a tensor carries no direction (all eigenvalues ~0, e.g. a piece without
@@ -25,6 +27,12 @@ struct DirectionFrame {
 /// One frame per cell; both inputs hold one symmetric tensor per cell (same size, else InputError).
 /// A non-finite tensor gives ComputeError "direction frames: the frame of cell N is not finite; ...".
 std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Mat3>& normal_tensors);
+
+/// The principal eigenvector of each cell's normal tensor, or zero where it carries no direction.
+std::vector<Vec3> normal_axes(const std::vector<Mat3>& normal_tensors);
+
+/// The same frames as from the normal tensors whose normal_axes these are.
+std::vector<DirectionFrame> direction_frames(const std::vector<Mat3>& langer_tensors, const std::vector<Vec3>& normal_axes);
 
 /// The frame of one cell (see above).
 DirectionFrame direction_frame(const Mat3& langer_tensor, const Mat3& normal_tensor);

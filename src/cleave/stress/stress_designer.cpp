@@ -57,14 +57,14 @@ struct StressDesigner::Operators {
     drop_held_vertex_rows(divergence, held);
     norm = equilibrium_norm(divergence);
     LineFieldInterpolator normal_interp(model.volume, weights);
-    normal_tensors = normal_interp.interpolate(surface_normal_targets(model));
+    normals = normal_axes(normal_interp.interpolate(surface_normal_targets(model)));
   }
   LineFieldInterpolator langer;
   EigenvalueInterpolator eigenvalues;
   SparseMatrix divergence;  ///< T, rows of held vertices dropped
   EquilibriumNorm norm;
   std::vector<VertexId> held_vertices;
-  std::vector<Mat3> normal_tensors;
+  std::vector<Vec3> normals;  ///< normal_axes of the interpolated normal field: the frames' normals never change
   std::unique_ptr<StressEquilibrator> equilibrator;  ///< built at the first equilibration (Kc factor)
 };
 
@@ -92,7 +92,7 @@ void StressDesigner::update_directions(const StressDesign& design, DesignResult&
   const double tolerance_mm = design.snap_tolerance_cells * model_.volume.grid().cell_size_mm;
   const std::vector<LineTarget> targets = stroke_line_targets(model_, design.strokes, tolerance_mm);
   const std::vector<Mat3> langer = ops_->langer.interpolate(targets);
-  out.frames = direction_frames(langer, ops_->normal_tensors);
+  out.frames = direction_frames(langer, ops_->normals);
   out.timings.directions_s = seconds_since(start);
 }
 
