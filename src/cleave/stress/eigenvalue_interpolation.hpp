@@ -46,7 +46,7 @@ class EigenvalueInterpolator {
   EigenvalueInterpolator(const LinkedVolume& volume, const DesignWeights& weights, std::vector<VertexId> held_vertices = {});
   EigenvalueSolution solve(const std::vector<DirectionFrame>& frames, const std::vector<EigenvalueTarget>& targets,
                            EigenvalueSolver solver, const std::vector<Vec3>& warm_start = {});
-  static constexpr double kReuseTolerance = 1e-13;  ///< relative residual of the CG with the kept factor
+  static constexpr double kReuseTolerance = 1e-13;  ///< of the solve with the kept factor (SparseCholesky::solve_with_current_factor)
   /// Hard cap of the CG with the kept factor; it usually gives up earlier, on its cost estimate.
   static constexpr int kMaxReuseIterations = 400;
   /// Numeric factorizations done so far by the `cholesky` solver.

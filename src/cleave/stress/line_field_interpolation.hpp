@@ -29,7 +29,7 @@ class LineFieldInterpolator {
   LineFieldInterpolator(const LinkedVolume& volume, const DesignWeights& weights);
   /// One interpolated tensor per cell. Targets must name cells of the volume (InputError otherwise).
   std::vector<Mat3> interpolate(const std::vector<LineTarget>& targets);
-  static constexpr double kReuseTolerance = 1e-13;  ///< relative residual of the CG with the kept factor
+  static constexpr double kReuseTolerance = 1e-13;  ///< of the solve with the kept factor (SparseCholesky::solve_with_current_factor)
   static constexpr int kMaxReuseIterations = 40;
   /// Numeric factorizations done so far (1 after the first call when edits reuse the factor).
   int factorizations() const { return factorizations_; }

@@ -5,6 +5,8 @@
 
 #include <Eigen/CholmodSupport>
 #include <Eigen/LU>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
 #include <algorithm>
 #include <chrono>
 #include <cmath>
@@ -23,19 +25,91 @@ double seconds_between(Clock::time_point a, Clock::time_point b) { return std::c
 /// CG with the kept factor projects its remaining work from this iteration on at the earliest.
 constexpr int kFirstProjectedIteration = 4;
 
-/// Iterative refinement of a x = b with `solve` (an approximate inverse of a): true as soon as every
-/// column has ||b - a x|| <= relative_tolerance ||b||; false after `steps` corrections without that,
-/// or when x is not finite.
+/// A refinement of the Woodbury solve by G's columns alone goes on while each step reduces the
+/// residual by at least this factor.
+constexpr double kColumnRefinementGain = 10.0;
+
+/// max |a_ij| summed over a column: the 1-norm of a, for a symmetric matrix also its infinity-norm,
+/// a bound of its 2-norm.
+double norm_1(const Eigen::SparseMatrix<double>& a) {
+  double norm = 0.0;
+  for (Eigen::Index j = 0; j < a.outerSize(); ++j) {
+    double column = 0.0;
+    for (int k = a.outerIndexPtr()[j]; k < a.outerIndexPtr()[j + 1]; ++k) column += std::abs(a.valuePtr()[k]);
+    norm = std::max(norm, column);
+  }
+  return norm;
+}
+
+/// The normwise backward error of x, the largest over the columns of
+///   ||b - a x|| / (||a|| ||x|| + ||b||):
+/// the relative change of a and b that x solves exactly. A solve with a backward stable factor
+/// reaches a few units of rounding; unlike ||b - a x|| / ||b|| it does not count the rounding of
+/// a x itself (large where x is large) against the solution.
+double backward_error(double a_norm, const Eigen::MatrixXd& r, const Eigen::MatrixXd& x, const Eigen::MatrixXd& b) {
+  double worst = 0.0;
+  for (Eigen::Index col = 0; col < b.cols(); ++col) {
+    const double scale = a_norm * x.col(col).norm() + b.col(col).norm();
+    const double r_norm = r.col(col).norm();
+    if (r_norm > 0.0) worst = std::max(worst, scale > 0.0 ? r_norm / scale : std::numeric_limits<double>::infinity());
+  }
+  return worst;
+}
+
+/// r = b - a x over the rows [begin, end) of a symmetric a stored whole (ColMajor: its columns are
+/// its rows), x with its rows contiguous; kColumns fixed (the design's 1, 3 and 6 right-hand sides,
+/// vectorised) or Eigen::Dynamic.
+template <int kColumns, typename RowMajorMatrix>
+void symmetric_residual_rows(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, const RowMajorMatrix& x_rows,
+                             Eigen::Index begin, Eigen::Index end, RowMajorMatrix& r) {
+  using Row = Eigen::Matrix<double, 1, kColumns>;
+  const Eigen::Index columns = x_rows.cols();
+  Row sum(columns);
+  for (Eigen::Index j = begin; j < end; ++j) {
+    sum.setZero();
+    for (int k = a.outerIndexPtr()[j]; k < a.outerIndexPtr()[j + 1]; ++k)
+      sum.noalias() += a.valuePtr()[k] * Eigen::Map<const Row>(x_rows.data() + static_cast<Eigen::Index>(a.innerIndexPtr()[k]) * columns, columns);
+    r.row(j) = b.row(j) - sum;
+  }
+}
+
+/// b - a x for a symmetric a stored whole, in parallel over the rows; one pass over a for all
+/// columns of x.
+Eigen::MatrixXd symmetric_residual(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, const Eigen::MatrixXd& x) {
+  using RowMajorMatrix = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+  const RowMajorMatrix x_rows = x;  // a row's columns next to each other for the gather
+  RowMajorMatrix r(b.rows(), b.cols());
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, a.outerSize(), 1024), [&](const tbb::blocked_range<Eigen::Index>& rows) {
+    switch (x.cols()) {
+      case 1: symmetric_residual_rows<1>(a, b, x_rows, rows.begin(), rows.end(), r); break;
+      case 3: symmetric_residual_rows<3>(a, b, x_rows, rows.begin(), rows.end(), r); break;
+      case 6: symmetric_residual_rows<6>(a, b, x_rows, rows.begin(), rows.end(), r); break;
+      default: symmetric_residual_rows<Eigen::Dynamic>(a, b, x_rows, rows.begin(), rows.end(), r); break;
+    }
+  });
+  return r;
+}
+
+/// g w in parallel over blocks of g's rows (g tall: n x G's columns, w a few columns).
+Eigen::MatrixXd multiply_by_rows(const Eigen::MatrixXd& g, const Eigen::MatrixXd& w) {
+  Eigen::MatrixXd out(g.rows(), w.cols());
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, g.rows(), 2048), [&](const tbb::blocked_range<Eigen::Index>& rows) {
+    const auto count = static_cast<Eigen::Index>(rows.size());
+    out.middleRows(rows.begin(), count).noalias() = g.middleRows(rows.begin(), count) * w;
+  });
+  return out;
+}
+
+/// Iterative refinement of a x = b with `solve` (an approximate inverse of a): true as soon as the
+/// backward error of x is at most `tolerance`; false after `steps` corrections without that, or
+/// when x is not finite.
 template <typename Solve>
-bool refine(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x, double relative_tolerance,
-            int steps, const Solve& solve) {
-  const Eigen::VectorXd b_norm = b.colwise().norm().transpose();
+bool refine(const Eigen::SparseMatrix<double>& a, double a_norm, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+            double tolerance, int steps, const Solve& solve) {
   for (int step = 0;; ++step) {
     if (!x.allFinite()) return false;
-    const Eigen::MatrixXd r = b - a * x;
-    bool converged = true;
-    for (Eigen::Index col = 0; col < b.cols() && converged; ++col) converged = r.col(col).norm() <= relative_tolerance * b_norm[col];
-    if (converged) return true;
+    const Eigen::MatrixXd r = symmetric_residual(a, b, x);
+    if (backward_error(a_norm, r, x, b) <= tolerance) return true;
     if (step == steps) return false;
     x += solve(r);
   }
@@ -61,12 +135,12 @@ struct SparseCholesky::Impl {
 
   bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
     if (!analyzed || static_cast<std::size_t>(a.outerSize() + 1) != outer.size()) return false;
-    for (std::size_t i = 0; i < outer.size(); ++i)
-      if (outer[i] != a.outerIndexPtr()[i]) return false;
-    if (static_cast<std::size_t>(outer.back()) != inner.size()) return false;
-    for (std::size_t i = 0; i < inner.size(); ++i)
-      if (inner[i] != a.innerIndexPtr()[i]) return false;
-    return true;
+    if (!std::equal(outer.begin(), outer.end(), a.outerIndexPtr())) return false;
+    return static_cast<std::size_t>(outer.back()) == inner.size() && std::equal(inner.begin(), inner.end(), a.innerIndexPtr());
+  }
+  /// Whether `a` (of the same pattern) has the factorized matrix's values.
+  bool same_values(const Eigen::SparseMatrix<double>& a) const {
+    return values.size() == static_cast<std::size_t>(a.nonZeros()) && std::equal(values.begin(), values.end(), a.valuePtr());
   }
 };
 
@@ -103,10 +177,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
 Eigen::Index SparseCholesky::low_rank_rows() const { return static_cast<Eigen::Index>(impl_->low_rank_row.size()); }
 
 bool SparseCholesky::factor_is_of(const Eigen::SparseMatrix<double>& a) const {
-  if (!impl_->same_pattern(a) || impl_->values.size() != static_cast<std::size_t>(a.nonZeros())) return false;
-  for (std::size_t i = 0; i < impl_->values.size(); ++i)
-    if (impl_->values[i] != a.valuePtr()[i]) return false;
-  return true;
+  return impl_->same_pattern(a) && impl_->same_values(a);
 }
 
 Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const {
@@ -121,16 +192,24 @@ Eigen::MatrixXd SparseCholesky::solve_refined(const Eigen::SparseMatrix<double>&
 bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b,
                                                Eigen::MatrixXd& x, double relative_tolerance, int max_iterations) const {
   last_iterations_ = 0;
+  last_factor_solves_ = 0;
   if (!impl_->analyzed || !impl_->same_pattern(a) || x.rows() != b.rows() || x.cols() != b.cols()) return false;
-  if (factor_is_of(a)) {  // only the right-hand side changed: the factor is exact
-    // Refined as solve_refined does, but only until the tolerance is met (usually one step).
-    x = solve(b);
-    refine(a, b, x, relative_tolerance, kRefinementSteps, [&](const Eigen::MatrixXd& r) { return solve(r); });
-    return true;
-  }
   // Giving up costs a factorization and a refined solve of every column.
   const double refactor_seconds =
       impl_->factor_seconds + static_cast<double>(b.cols()) * (kRefinementSteps + 1) * impl_->solve_seconds;
+  if (impl_->same_values(a)) {  // only the right-hand side changed: the factor is exact
+    // Without a solve when G has a column for every row where b is not zero (a value typed at a
+    // control point the last edits placed); otherwise refined as solve_refined does, but only
+    // until the tolerance is met (usually one step).
+    if (low_rank_rows() > 0 && solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, false)) return true;
+    x = solve(b);
+    ++last_factor_solves_;
+    refine(a, norm_1(a), b, x, relative_tolerance, kRefinementSteps, [&](const Eigen::MatrixXd& r) {
+      ++last_factor_solves_;
+      return solve(r);
+    });
+    return true;
+  }
   // A change of d diagonal entries only (constraints added or removed) is a rank-d update: CG with
   // the old factor converges in about d + 1 iterations per column, with a residual that need not
   // fall before. Refactorize at once when those iterations cost more than a new factor.
@@ -144,7 +223,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       }
   if (diagonal_only) {
     const Eigen::MatrixXd start = x;
-    if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds)) return true;
+    if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, true)) return true;
     x = start;
   }
   Eigen::Index columns = 0;
@@ -163,6 +242,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
     const double r0_norm = r.norm();
     if (r0_norm <= relative_tolerance * b_norm) continue;
     Eigen::VectorXd z = impl_->llt.solve(r);
+    ++last_factor_solves_;
     Eigen::VectorXd p = z;
     double rz = r.dot(z);
     bool converged = false;
@@ -188,6 +268,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
         if (it + 1 + remaining > max_iterations || remaining * seconds_per_iteration > refactor_seconds) return false;
       }
       z = impl_->llt.solve(r);
+      ++last_factor_solves_;
       const double rz_next = r.dot(z);
       p = z + (rz_next / rz) * p;
       rz = rz_next;
@@ -200,65 +281,146 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
 }
 
 bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
-                                           double relative_tolerance, double refactor_seconds) const {
+                                           double relative_tolerance, double refactor_seconds, bool new_columns_allowed) const {
   Impl& impl = *impl_;
   const Eigen::Index n = a.rows();
   const Eigen::VectorXd diagonal = a.diagonal();
-  std::vector<Eigen::Index> missing;  // changed rows without a column of G yet
-  for (Eigen::Index r = 0; r < n; ++r)
-    if (diagonal[r] != impl.diagonal[r] && impl.column_of_row[static_cast<std::size_t>(r)] < 0) missing.push_back(r);
-  const auto kept = static_cast<Eigen::Index>(impl.low_rank_row.size());
-  const Eigen::Index rows = kept + static_cast<Eigen::Index>(missing.size());
-  if (rows == 0 || rows > kMaxLowRankRows || 8.0 * static_cast<double>(n) * static_cast<double>(rows) > kMaxLowRankBytes)
-    return false;
-  // The new columns cost about their count times one column's solve (measured on the last batch
-  // of columns, or on the last solve): not more than a new factor.
-  const double column_seconds = impl.column_seconds > 0 ? impl.column_seconds : impl.solve_seconds;
-  if (static_cast<double>(missing.size()) * column_seconds > refactor_seconds) return false;
-  // y = a0^-1 b and the new columns in one solve (the factor is read once for all of them).
-  const auto new_columns = static_cast<Eigen::Index>(missing.size());
-  Eigen::MatrixXd y;
-  if (new_columns > 0) {
-    const Clock::time_point start = Clock::now();
-    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, new_columns + b.cols());
-    for (Eigen::Index c = 0; c < new_columns; ++c) rhs(missing[static_cast<std::size_t>(c)], c) = 1.0;
-    rhs.rightCols(b.cols()) = b;
-    const Eigen::MatrixXd solved = impl.llt.solve(rhs);
-    if (impl.llt.info() != Eigen::Success || !solved.allFinite()) return false;
-    impl.column_seconds = seconds_between(start, Clock::now()) / static_cast<double>(rhs.cols());
-    impl.low_rank_columns.conservativeResize(n, rows);
-    impl.low_rank_columns.rightCols(new_columns) = solved.leftCols(new_columns);
-    y = solved.rightCols(b.cols());
-    for (std::size_t c = 0; c < missing.size(); ++c) {
-      impl.column_of_row[static_cast<std::size_t>(missing[c])] = kept + static_cast<Eigen::Index>(c);
-      impl.low_rank_row.push_back(missing[c]);
+  const Eigen::VectorXd change = diagonal - impl.diagonal;  // a = a0 + diag(change)
+  const auto has_column = [&](Eigen::Index r) { return impl.column_of_row[static_cast<std::size_t>(r)] >= 0; };
+  std::vector<Eigen::Index> changed;          // rows of E: diagonal entries that differ from a0's
+  std::vector<Eigen::Index> missing_changed;  // ... without a column of G yet
+  std::vector<Eigen::Index> missing_support;  // other rows where b is not zero, without a column
+  for (Eigen::Index r = 0; r < n; ++r) {
+    if (change[r] != 0.0) {
+      changed.push_back(r);
+      if (!has_column(r)) missing_changed.push_back(r);
+    } else if (!has_column(r) && (b.row(r).array() != 0.0).any()) {
+      missing_support.push_back(r);
     }
   }
-  // a = a0 + E D E^T over every kept row (D = 0 where a row has its factorized value again).
-  const Eigen::MatrixXd& g = impl.low_rank_columns;
-  Eigen::VectorXd d(rows);
-  for (Eigen::Index c = 0; c < rows; ++c) {
-    const Eigen::Index r = impl.low_rank_row[static_cast<std::size_t>(c)];
-    d[c] = diagonal[r] - impl.diagonal[r];
-  }
-  Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(rows, rows);  // I + D E^T G
-  for (Eigen::Index c = 0; c < rows; ++c)
-    for (Eigen::Index k = 0; k < rows; ++k) capacitance(k, c) += d[k] * g(impl.low_rank_row[static_cast<std::size_t>(k)], c);
-  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
-  // a^-1 r from y = a0^-1 r.
-  const auto update = [&](Eigen::MatrixXd& solved) {
-    Eigen::MatrixXd t(rows, solved.cols());
-    for (Eigen::Index k = 0; k < rows; ++k) t.row(k) = d[k] * solved.row(impl.low_rank_row[static_cast<std::size_t>(k)]);
-    solved.noalias() -= g * lu.solve(t);
+  const auto kept = static_cast<Eigen::Index>(impl.low_rank_row.size());
+  // The new columns cost about their count times one column's solve (measured on the last batch
+  // of columns, or on the last solve): not more than a new factor, and G stays within its bounds.
+  const double column_seconds = impl.column_seconds > 0 ? impl.column_seconds : impl.solve_seconds;
+  const auto affordable = [&](std::size_t count) {
+    const Eigen::Index rows = kept + static_cast<Eigen::Index>(count);
+    return rows <= kMaxLowRankRows && 8.0 * static_cast<double>(n) * static_cast<double>(rows) <= kMaxLowRankBytes &&
+           static_cast<double>(count) * column_seconds <= refactor_seconds;
   };
-  if (y.size() == 0) y = impl.llt.solve(b);
-  update(y);
-  x = std::move(y);
-  const bool converged = refine(a, b, x, relative_tolerance, kLowRankRefinementSteps, [&](const Eigen::MatrixXd& r) {
-    Eigen::MatrixXd solved = impl.llt.solve(r);
-    update(solved);
-    return solved;
-  });
+  const std::size_t support_columns = missing_changed.size() + missing_support.size();
+  // y = a0^-1 b from G's columns of the rows where b is not zero (no solve), when they exist or
+  // can be afforded; otherwise from a solve with the factor.
+  const bool y_from_columns = support_columns == 0 || (new_columns_allowed && affordable(support_columns));
+  if (!y_from_columns && (!new_columns_allowed || changed.empty() || !affordable(missing_changed.size()))) return false;
+  std::vector<Eigen::Index> missing = missing_changed;
+  if (y_from_columns) missing.insert(missing.end(), missing_support.begin(), missing_support.end());
+  const auto new_columns = static_cast<Eigen::Index>(missing.size());
+  const Eigen::Index rhs_columns = y_from_columns ? 0 : b.cols();
+  Eigen::MatrixXd y;
+  if (new_columns + rhs_columns > 0) {
+    // The new columns and (when needed) y in one solve: the factor is read once for all of them.
+    const Clock::time_point start = Clock::now();
+    Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, new_columns + rhs_columns);
+    for (Eigen::Index c = 0; c < new_columns; ++c) rhs(missing[static_cast<std::size_t>(c)], c) = 1.0;
+    if (rhs_columns > 0) rhs.rightCols(rhs_columns) = b;
+    Eigen::MatrixXd solved = impl.llt.solve(rhs);
+    ++last_factor_solves_;
+    if (impl.llt.info() != Eigen::Success || !solved.allFinite()) return false;
+    if (new_columns > 0) {
+      // One step of iterative refinement of the new columns against a0 = a - diag(change): the
+      // kept columns are reused by every later edit, whose result is then exact without solves.
+      Eigen::MatrixXd g = solved.leftCols(new_columns);
+      for (int step = 0; step < kColumnRefinementSteps; ++step) {
+        Eigen::MatrixXd residual = symmetric_residual(a, rhs.leftCols(new_columns), g);
+        residual += change.asDiagonal() * g;
+        g += impl.llt.solve(residual);
+        ++last_factor_solves_;
+      }
+      if (!g.allFinite()) return false;
+      impl.low_rank_columns.conservativeResize(n, kept + new_columns);
+      impl.low_rank_columns.rightCols(new_columns) = g;
+      for (std::size_t c = 0; c < missing.size(); ++c) {
+        impl.column_of_row[static_cast<std::size_t>(missing[c])] = kept + static_cast<Eigen::Index>(c);
+        impl.low_rank_row.push_back(missing[c]);
+      }
+    }
+    impl.column_seconds = seconds_between(start, Clock::now()) / static_cast<double>(rhs.cols());
+    if (rhs_columns > 0) y = solved.rightCols(rhs_columns);
+  }
+  const Eigen::MatrixXd& g = impl.low_rank_columns;
+  const auto column_of = [&](Eigen::Index r) { return impl.column_of_row[static_cast<std::size_t>(r)]; };
+  // a = a0 + E D E^T over the changed rows: with W the coefficients of r on G's rows,
+  //   a^-1 r = a0^-1 r - G_E (I + D E^T G_E)^-1 D E^T a0^-1 r,   a0^-1 r = G W (r zero elsewhere).
+  const auto rank = static_cast<Eigen::Index>(changed.size());
+  Eigen::MatrixXd g_at_changed(rank, g.cols());  // E^T G
+  for (Eigen::Index k = 0; k < rank; ++k) g_at_changed.row(k) = g.row(changed[static_cast<std::size_t>(k)]);
+  Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(rank, rank);  // I + D E^T G_E
+  for (Eigen::Index c = 0; c < rank; ++c)
+    for (Eigen::Index k = 0; k < rank; ++k)
+      capacitance(k, c) += change[changed[static_cast<std::size_t>(k)]] * g_at_changed(k, column_of(changed[static_cast<std::size_t>(c)]));
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
+  // Subtracts (I + D E^T G_E)^-1 D (E^T a0^-1 r) from the changed rows' coefficients in w.
+  const auto correct_coefficients = [&](Eigen::MatrixXd& w, const Eigen::MatrixXd& a0_inverse_r_at_changed) {
+    if (rank == 0) return;
+    const Eigen::MatrixXd z = lu.solve(change(changed).asDiagonal() * a0_inverse_r_at_changed);
+    for (Eigen::Index k = 0; k < rank; ++k) w.row(column_of(changed[static_cast<std::size_t>(k)])) -= z.row(k);
+  };
+  const auto coefficients_on_rows = [&](const Eigen::MatrixXd& r) {  // W: r on G's rows, zero elsewhere
+    Eigen::MatrixXd w(g.cols(), r.cols());
+    for (std::size_t c = 0; c < impl.low_rank_row.size(); ++c) w.row(static_cast<Eigen::Index>(c)) = r.row(impl.low_rank_row[c]);
+    return w;
+  };
+  // a^-1 r from G alone, for r zero outside G's rows: G (W - Z), one product with G.
+  const auto solve_by_columns = [&](const Eigen::MatrixXd& r) {
+    Eigen::MatrixXd w = coefficients_on_rows(r);
+    correct_coefficients(w, g_at_changed * w);
+    return multiply_by_rows(g, w);
+  };
+  // a^-1 r from y = a0^-1 r (a solve with the factor): y - G Z.
+  const auto update_solved = [&](Eigen::MatrixXd& solved) {
+    if (rank == 0) return;
+    Eigen::MatrixXd w = Eigen::MatrixXd::Zero(g.cols(), solved.cols());
+    correct_coefficients(w, solved(changed, Eigen::all));
+    solved += multiply_by_rows(g, w);
+  };
+  if (y_from_columns) {
+    x = solve_by_columns(b);
+  } else {
+    update_solved(y);
+    x = std::move(y);
+  }
+  // The result's error is mostly on the changed rows (the capacitance system's rounding, amplified
+  // by its condition), so its residual lives there too and G's columns correct it without a solve
+  // while each correction gains a factor kColumnRefinementGain; a residual that stays elsewhere is
+  // refined with solves with the factor (at most kLowRankRefinementSteps of each kind).
+  const double a_norm = norm_1(a);
+  double last_error = std::numeric_limits<double>::infinity();
+  bool by_columns = true;
+  int steps = 0;
+  bool converged = false;
+  while (x.allFinite()) {
+    const Eigen::MatrixXd r = symmetric_residual(a, b, x);
+    const double error = backward_error(a_norm, r, x, b);
+    if (error <= relative_tolerance) {
+      converged = true;
+      break;
+    }
+    if (by_columns && (error > last_error / kColumnRefinementGain || steps == kLowRankRefinementSteps)) {
+      by_columns = false;
+      steps = 0;
+    }
+    if (!by_columns && steps == kLowRankRefinementSteps) break;
+    last_error = error;
+    ++steps;
+    if (by_columns) {
+      x += solve_by_columns(r);
+    } else {
+      ++last_factor_solves_;
+      Eigen::MatrixXd solved = impl.llt.solve(r);
+      update_solved(solved);
+      x += solved;
+    }
+  }
   if (converged) ++low_rank_solves_;
   return converged;
 }

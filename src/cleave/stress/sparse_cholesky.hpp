@@ -42,19 +42,27 @@ class SparseCholesky {
   /// measured cost exceeds that of a new factor, or when they would exceed max_iterations.
   /// Before that CG, a change of diagonal entries only (a = a0 + E D E^T, E the unit columns of
   /// the changed rows) is solved exactly with the kept factor by the Woodbury identity
-  ///   a^-1 = a0^-1 - G (I + D E^T G)^-1 D G^T,   G = a0^-1 E,
-  /// with G's columns kept across calls while the factor stays (a later edit solves only for rows
-  /// it changes first), followed by iterative refinement against `a` (see kMaxLowRankRows).
-  /// Returns true when every column reached
-  /// ||b - a x|| <= relative_tolerance ||b||; false (x unspecified) when there is no factor, the
-  /// pattern differs, or CG gave up: then factorize(a).
+  ///   a^-1 = a0^-1 - G_E (I + D E^T G_E)^-1 D G_E^T,   G = a0^-1 [e_r ...],
+  /// with G's columns (each refined once against a0) kept across calls while the factor stays.
+  /// G also gets the columns of the rows where b is not zero (the design's right-hand sides live
+  /// on the constrained cells only), so that a0^-1 b = G b_rows needs no solve either: once the
+  /// columns of an edit's rows exist (an edit back and forth, a value typed at a placed control
+  /// point: also for a right-hand-side-only change), the solve is dense algebra on G and a
+  /// residual check. Its rounding error sits on the changed rows, so G's columns also refine it;
+  /// a solve with the factor refines only what they cannot (see kMaxLowRankRows).
+  /// Returns true when every column reached the tolerance: CG a relative residual
+  /// ||b - a x|| <= relative_tolerance ||b||, the solves with the factor and the Woodbury update a
+  /// normwise backward error ||b - a x|| / (||a||_1 ||x|| + ||b||) <= relative_tolerance (the
+  /// level a backward stable direct solve reaches; the rounding of a x, large where x is large,
+  /// is not held against x). False (x unspecified) when there is no factor, the pattern differs,
+  /// or CG gave up: then factorize(a).
   bool solve_with_current_factor(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
                                  double relative_tolerance, int max_iterations) const;
   /// Whether the factor is of exactly `a` (same pattern and values).
   bool factor_is_of(const Eigen::SparseMatrix<double>& a) const;
   /// Preconditioned CG iterations run by the last solve_with_current_factor (all columns).
   int last_iterations() const { return last_iterations_; }
-  /// Rows of a0^-1 E kept for the Woodbury update (0 after a factorization).
+  /// Columns of G kept for the Woodbury update (0 after a factorization).
   Eigen::Index low_rank_rows() const;
   /// Calls of solve_with_current_factor answered by the Woodbury update.
   int low_rank_solves() const { return low_rank_solves_; }
@@ -64,6 +72,11 @@ class SparseCholesky {
   static constexpr double kMaxLowRankBytes = 256.0 * 1024 * 1024;
   /// Refinement steps of the Woodbury solve (each one solve with the kept factor) before it gives up.
   static constexpr int kLowRankRefinementSteps = 3;
+  /// Refinement steps of each new column of G against a0 (the columns are reused by later edits).
+  static constexpr int kColumnRefinementSteps = 1;
+  /// Solves with the factor (each over all columns of its right-hand side) that the last
+  /// solve_with_current_factor ran: 0 when G answered alone.
+  int last_factor_solves() const { return last_factor_solves_; }
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 
@@ -71,11 +84,13 @@ class SparseCholesky {
   struct Impl;
   std::unique_ptr<Impl> impl_;
   /// The Woodbury update of solve_with_current_factor: true when x reached the tolerance.
-  /// Gives up (false) before solving when its new columns would cost more than refactor_seconds.
+  /// Gives up (false) before solving when its new columns would cost more than refactor_seconds,
+  /// or, without new_columns_allowed, when G lacks a column it needs.
   bool solve_diagonal_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
-                             double relative_tolerance, double refactor_seconds) const;
+                             double relative_tolerance, double refactor_seconds, bool new_columns_allowed) const;
   int reused_ = 0;
   mutable int last_iterations_ = 0;
+  mutable int last_factor_solves_ = 0;
   mutable int low_rank_solves_ = 0;
 };
 
