@@ -43,7 +43,7 @@ class SparseCholesky {
   /// Before that CG, a change of diagonal entries only (a = a0 + E D E^T, E the unit columns of
   /// the changed rows) is solved exactly with the kept factor by the Woodbury identity
   ///   a^-1 = a0^-1 - G_E (I + D E^T G_E)^-1 D G_E^T,   G = a0^-1 [e_r ...],
-  /// with G's columns (each refined once against a0) kept across calls while the factor stays.
+  /// with G's columns kept across calls while the factor stays.
   /// G also gets the columns of the rows where b is not zero (the design's right-hand sides live
   /// on the constrained cells only), so that a0^-1 b = G b_rows needs no solve either: once the
   /// columns of an edit's rows exist (an edit back and forth, a value typed at a placed control
@@ -72,8 +72,6 @@ class SparseCholesky {
   static constexpr double kMaxLowRankBytes = 256.0 * 1024 * 1024;
   /// Refinement steps of the Woodbury solve (each one solve with the kept factor) before it gives up.
   static constexpr int kLowRankRefinementSteps = 3;
-  /// Refinement steps of each new column of G against a0 (the columns are reused by later edits).
-  static constexpr int kColumnRefinementSteps = 1;
   /// Solves with the factor (each over all columns of its right-hand side) that the last
   /// solve_with_current_factor ran: 0 when G answered alone.
   int last_factor_solves() const { return last_factor_solves_; }
