@@ -132,8 +132,10 @@ TEST(SparseCholeskyUpdate, TooManyChangedRowsFallBackToTheCaller) {
   Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
   // More rows than the update keeps: the kept factor alone cannot answer at once; whatever the
   // caller is told, a true answer must be the solution.
+  // Rows 1 to kMaxLowRankRows + 1 change (row 0 was constrained already): one more than G may hold,
+  // whatever the columns' measured cost.
   std::vector<int> many;
-  for (int c = 0; c < kCells && static_cast<Eigen::Index>(many.size()) <= SparseCholesky::kMaxLowRankRows; ++c) many.push_back(c);
+  for (int c = 0; c < kCells && static_cast<Eigen::Index>(many.size()) <= SparseCholesky::kMaxLowRankRows + 1; ++c) many.push_back(c);
   const Eigen::SparseMatrix<double> a = design_system(kSide, many, kConstraint);
   const Eigen::MatrixXd b = targets(kCells, many, kConstraint);
   if (chol.solve_with_current_factor(a, b, x, kTolerance, 40)) {
