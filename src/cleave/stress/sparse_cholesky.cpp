@@ -28,8 +28,8 @@ constexpr int kFirstProjectedIteration = 4;
 /// New columns of G may cost this many refactorizations: unlike a new factor they are kept, and
 /// every later edit on their rows (a stroke moved back, undo and redo, values typed at placed
 /// control points) is then solved without a solve with the factor. A stroke of the abdomen at
-/// 45k cells brings about 230 rows (142 changed, 86 more of the right-hand side): 1.2 s once,
-/// against 0.7-0.8 s of a refactorization at every edit.
+/// 45k cells changes 142 rows (0.7 s of columns once, against 0.7-0.8 s of a refactorization at
+/// every edit), and its right-hand side has 86 more.
 constexpr double kColumnBudget = 4.0;
 
 /// A refinement of the Woodbury solve by G's columns alone goes on while each step reduces the
@@ -316,9 +316,15 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
            static_cast<double>(count) * column_seconds <= kColumnBudget * refactor_seconds;
   };
   const std::size_t support_columns = missing_changed.size() + missing_support.size();
-  // y = a0^-1 b from G's columns of the rows where b is not zero (no solve), when they exist or
-  // can be afforded; otherwise from a solve with the factor.
-  const bool y_from_columns = support_columns == 0 || (new_columns_allowed && affordable(support_columns));
+  // y = a0^-1 b from G's columns of the rows where b is not zero (no solve), when they exist or can
+  // be afforded; otherwise from a solve with the factor. The right-hand side's extra columns are
+  // bought at once only while cheap (one refactorization); dearer, only by an edit whose changed
+  // rows all have columns already (a stroke moved back, undo, redo): an edit to fresh cells (a drag)
+  // pays for its changed rows only, so that G does not fill with columns a drag never reuses.
+  const double all_columns_seconds = static_cast<double>(support_columns) * column_seconds;
+  const bool y_from_columns =
+      support_columns == 0 || (new_columns_allowed && affordable(support_columns) &&
+                               (missing_changed.empty() || all_columns_seconds <= refactor_seconds));
   if (!y_from_columns && (!new_columns_allowed || changed.empty() || !affordable(missing_changed.size()))) return false;
   std::vector<Eigen::Index> missing = missing_changed;
   if (y_from_columns) missing.insert(missing.end(), missing_support.begin(), missing_support.end());
