@@ -74,8 +74,10 @@ void symmetric_residual_rows(const Eigen::SparseMatrix<double>& a, const Eigen::
   Row sum(columns);
   for (Eigen::Index j = begin; j < end; ++j) {
     sum.setZero();
-    for (int k = a.outerIndexPtr()[j]; k < a.outerIndexPtr()[j + 1]; ++k)
-      sum.noalias() += a.valuePtr()[k] * Eigen::Map<const Row>(x_rows.data() + static_cast<Eigen::Index>(a.innerIndexPtr()[k]) * columns, columns);
+    for (int k = a.outerIndexPtr()[j]; k < a.outerIndexPtr()[j + 1]; ++k) {
+      const double* x_row = x_rows.data() + static_cast<Eigen::Index>(a.innerIndexPtr()[k]) * columns;
+      sum.noalias() += a.valuePtr()[k] * Eigen::Map<const Row>(x_row, columns);
+    }
     r.row(j) = b.row(j) - sum;
   }
 }
@@ -359,9 +361,10 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
   Eigen::MatrixXd g_at_changed(rank, g.cols());  // E^T G
   for (Eigen::Index k = 0; k < rank; ++k) g_at_changed.row(k) = g.row(changed[static_cast<std::size_t>(k)]);
   Eigen::MatrixXd capacitance = Eigen::MatrixXd::Identity(rank, rank);  // I + D E^T G_E
-  for (Eigen::Index c = 0; c < rank; ++c)
-    for (Eigen::Index k = 0; k < rank; ++k)
-      capacitance(k, c) += change[changed[static_cast<std::size_t>(k)]] * g_at_changed(k, column_of(changed[static_cast<std::size_t>(c)]));
+  for (Eigen::Index c = 0; c < rank; ++c) {
+    const Eigen::Index column = column_of(changed[static_cast<std::size_t>(c)]);
+    for (Eigen::Index k = 0; k < rank; ++k) capacitance(k, c) += change[changed[static_cast<std::size_t>(k)]] * g_at_changed(k, column);
+  }
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
   // Subtracts (I + D E^T G_E)^-1 D (E^T a0^-1 r) from the changed rows' coefficients in w.
   const auto correct_coefficients = [&](Eigen::MatrixXd& w, const Eigen::MatrixXd& a0_inverse_r_at_changed) {

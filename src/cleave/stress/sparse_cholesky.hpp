@@ -27,8 +27,8 @@ class SparseCholesky {
   /// matrix): the design systems (L^T L, condition ~ n^2) lose digits in a plain solve.
   Eigen::MatrixXd solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const;
   static constexpr int kRefinementSteps = 2;
-  /// Solves a x = b for a matrix `a` with the pattern of the factorized one, starting from x (the
-  /// previous solution). When `a` has exactly the values of the factorized matrix (an edit that
+  /// Solves a x = b for a matrix `a` with the pattern of the factorized one (SPD, both triangles
+  /// stored, as for factorize), starting from x (the previous solution). When `a` has exactly the values of the factorized matrix (an edit that
   /// changed only the right-hand side) this is one solve with the factor, refined until the
   /// tolerance is met (at most kRefinementSteps steps; usually one). Otherwise (a
   /// design edit changed some values) it runs conjugate gradients preconditioned with the kept
