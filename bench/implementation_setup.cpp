@@ -16,7 +16,8 @@ SolverKind solver_of(Implementation implementation) {
   return SolverKind::multigrid_cg;
 }
 
-ImplementationScope::ImplementationScope(Implementation implementation) : solver_(solver_of(implementation)) {
+ImplementationScope::ImplementationScope(Implementation implementation)
+    : solver_(solver_of(implementation)), parallel_substitution_(implementation != Implementation::cholmod) {
   if (implementation == Implementation::paper)
     one_thread_ = std::make_unique<tbb::global_control>(tbb::global_control::max_allowed_parallelism, 1);
 }

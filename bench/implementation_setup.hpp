@@ -4,7 +4,7 @@
 //   paper     the same multigrid CG on one thread (the paper's simulation used the geometric
 //             multigrid of Dick et al. 2011 on one core)
 //   eigen_cg  Eigen's ConjugateGradient with incomplete Cholesky
-//   cholmod   SuiteSparse CHOLMOD
+//   cholmod   SuiteSparse CHOLMOD as shipped (substitution by cholmod_solve)
 //
 //   ImplementationScope scope(Implementation::paper);   // limits TBB to one thread until destroyed
 //   SolverKind kind = scope.solver();
@@ -25,9 +25,12 @@ class ImplementationScope {
  public:
   explicit ImplementationScope(Implementation implementation);
   SolverKind solver() const { return solver_; }
+  /// Whether CHOLMOD's factor is substituted on all cores: cleave's own use of it, not the peer's.
+  bool parallel_substitution() const { return parallel_substitution_; }
 
  private:
   SolverKind solver_;
+  bool parallel_substitution_;
   std::unique_ptr<tbb::global_control> one_thread_;
 };
 

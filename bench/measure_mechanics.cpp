@@ -33,6 +33,7 @@ MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchS
   const SparseMatrix stiffness = assemble_stiffness(model);
   const ImplementationScope scope(implementation);
   options.solver = scope.solver();
+  options.settings.parallel_substitution = scope.parallel_substitution();
   MechanicsOutcome out;
   std::vector<double> samples_ms;
   StaticResult result;
@@ -59,6 +60,7 @@ MechanicsOutcome measure_dynamic_step(const TissueModel& uncut, const BenchScena
   const ImplementationScope scope(implementation);
   DynamicsSettings settings;
   settings.solver = scope.solver();
+  settings.solve.parallel_substitution = scope.parallel_substitution();
   settings.mass_damping_per_s = kBenchMassDamping_per_s;
   Dynamics sim(model, scenario.residual_stress_kPa, settings);
   MechanicsOutcome out;

@@ -4,10 +4,12 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <optional>
 #include <vector>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
+#include "cleave/solve/supernodal_substitution.hpp"
 
 namespace cleave {
 namespace {
@@ -51,6 +53,7 @@ class CholmodSolver final : public LinearSolver {
                               pattern_inner_.size() == view.nzmax &&
                               std::equal(pattern_inner_.begin(), pattern_inner_.end(), a_.innerIndexPtr());
     if (!same_pattern) {
+      substitution_.reset();
       if (factor_ != nullptr) cholmod_free_factor(&factor_, &common_);
       factor_ = cholmod_analyze(&view, &common_);
       if (factor_ == nullptr) throw ComputeError(fmt::format("cholmod: analysis failed (status {})", common_.status));
@@ -62,6 +65,7 @@ class CholmodSolver final : public LinearSolver {
       const std::size_t minor = factor_->minor;
       const int dof = minor < n && factor_->Perm != nullptr ? static_cast<const int*>(factor_->Perm)[minor] : -1;
       pattern_outer_.clear();  // force a fresh analysis next time
+      substitution_.reset();
       cholmod_free_factor(&factor_, &common_);
       throw ComputeError(fmt::format(
           "cholmod: matrix is not positive definite (pivot {} of {} fails, dof {} of vertex {}); a piece without fixed "
@@ -69,6 +73,7 @@ class CholmodSolver final : public LinearSolver {
           minor, n, dof, dof >= 0 ? dof / 3 : -1));
     }
     if (common_.status < CHOLMOD_OK) throw ComputeError(fmt::format("cholmod: factorization failed (status {})", common_.status));
+    if (settings_.parallel_substitution && !substitution_) substitution_.emplace(*factor_);
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
@@ -83,6 +88,26 @@ class CholmodSolver final : public LinearSolver {
       report.converged = std::isfinite(b_norm);
       return report;
     }
+    if (substitution_) {
+      Vector solved = b;
+      substitution_->solve(*factor_, solved);
+      if (solved.allFinite()) x = solved;
+    } else {
+      solve_with_cholmod(b, x);
+    }
+    report.iterations = 1;
+    Vector r;
+    residual(a_, b, x, r);
+    report.relative_residual = r.norm() / b_norm;
+    report.converged = report.relative_residual <= settings_.relative_tolerance;
+    return report;
+  }
+
+  std::string_view name() const override { return "cholmod"; }
+
+ private:
+  /// x = A^-1 b by cholmod_solve (x unchanged when the result is not finite).
+  void solve_with_cholmod(const Vector& b, Vector& x) {
     cholmod_dense rhs{};
     rhs.nrow = static_cast<std::size_t>(b.size());
     rhs.ncol = 1;
@@ -97,21 +122,13 @@ class CholmodSolver final : public LinearSolver {
       if (values.allFinite()) x = values;
       cholmod_free_dense(&solution, &common_);
     }
-    report.iterations = 1;
-    Vector r;
-    residual(a_, b, x, r);
-    report.relative_residual = r.norm() / b_norm;
-    report.converged = report.relative_residual <= settings_.relative_tolerance;
-    return report;
   }
 
-  std::string_view name() const override { return "cholmod"; }
-
- private:
   SolveSettings settings_;
   SparseMatrix a_;
   cholmod_common common_{};
   cholmod_factor* factor_ = nullptr;
+  std::optional<SupernodalSubstitution> substitution_;  ///< with parallel_substitution: the schedule of factor_
   std::vector<int> pattern_outer_, pattern_inner_;
 };
 

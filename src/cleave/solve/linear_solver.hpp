@@ -32,6 +32,9 @@ struct SolveSettings {
   /// Read by the CG solvers of cleave (multigrid); the peers solve to relative_tolerance.
   double initial_residual_tolerance = 0;
   int max_iterations = 2000;
+  /// cholmod: forward and back substitution with the factor on all cores (SupernodalSubstitution,
+  /// cleave's own); false: cholmod_solve as SuiteSparse ships it (the bench's peer).
+  bool parallel_substitution = true;
 };
 
 struct SolveReport {

@@ -11,9 +11,11 @@
 #include <chrono>
 #include <cmath>
 #include <limits>
+#include <optional>
 #include <vector>
 
 #include "cleave/core/error.hpp"
+#include "cleave/solve/supernodal_substitution.hpp"
 
 namespace cleave {
 namespace {
@@ -124,10 +126,21 @@ bool refine(const Eigen::SparseMatrix<double>& a, double a_norm, const Eigen::Ma
   }
 }
 
+/// Eigen's CHOLMOD wrapper with its factor readable (for the parallel substitution).
+class CholmodLlt : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> {
+ public:
+  const cholmod_factor* factor() const { return m_cholmodFactor; }
+};
+
+/// Right-hand sides up to this many columns are substituted on all cores (SupernodalSubstitution);
+/// wider blocks go to CHOLMOD's solve, whose BLAS-3 kernels already use them.
+constexpr Eigen::Index kParallelSubstitutionColumns = 8;
+
 }  // namespace
 
 struct SparseCholesky::Impl {
-  Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double>, Eigen::Lower> llt;
+  CholmodLlt llt;
+  std::optional<SupernodalSubstitution> substitution;  ///< schedule of the current analysis
   std::vector<int> outer;
   std::vector<int> inner;
   bool analyzed = false;
@@ -151,6 +164,13 @@ struct SparseCholesky::Impl {
   bool same_values(const Eigen::SparseMatrix<double>& a) const {
     return values.size() == static_cast<std::size_t>(a.nonZeros()) && std::equal(values.begin(), values.end(), a.valuePtr());
   }
+  /// a0^-1 b with the factor (not checked for finiteness).
+  Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const {
+    if (!substitution || b.cols() > kParallelSubstitutionColumns) return llt.solve(b);
+    Eigen::MatrixXd x = b;
+    substitution->solve(*llt.factor(), x);
+    return x;
+  }
 };
 
 SparseCholesky::SparseCholesky() : impl_(std::make_unique<Impl>()) {}
@@ -163,6 +183,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   if (impl_->same_pattern(a)) {
     ++reused_;
   } else {
+    impl_->substitution.reset();
     impl_->llt.analyzePattern(a);
     impl_->outer.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.outerSize() + 1);
     impl_->inner.assign(a.innerIndexPtr(), a.innerIndexPtr() + impl_->outer.back());
@@ -175,6 +196,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
     impl_->values.clear();
     throw ComputeError("sparse Cholesky factorization failed: the design system is not positive definite");
   }
+  if (!impl_->substitution) impl_->substitution.emplace(*impl_->llt.factor());
   impl_->factor_seconds = seconds_between(start, Clock::now());
   impl_->values.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
   impl_->diagonal = a.diagonal();
@@ -250,7 +272,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
     Eigen::VectorXd r = b.col(col) - a * xc;
     const double r0_norm = r.norm();
     if (r0_norm <= relative_tolerance * b_norm) continue;
-    Eigen::VectorXd z = impl_->llt.solve(r);
+    Eigen::VectorXd z = impl_->solve(r);
     ++last_factor_solves_;
     Eigen::VectorXd p = z;
     double rz = r.dot(z);
@@ -276,7 +298,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
         const double seconds_per_iteration = seconds_between(start, Clock::now()) / last_iterations_;
         if (it + 1 + remaining > max_iterations || remaining * seconds_per_iteration > refactor_seconds) return false;
       }
-      z = impl_->llt.solve(r);
+      z = impl_->solve(r);
       ++last_factor_solves_;
       const double rz_next = r.dot(z);
       p = z + (rz_next / rz) * p;
@@ -339,7 +361,7 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
     Eigen::MatrixXd rhs = Eigen::MatrixXd::Zero(n, new_columns + rhs_columns);
     for (Eigen::Index c = 0; c < new_columns; ++c) rhs(missing[static_cast<std::size_t>(c)], c) = 1.0;
     if (rhs_columns > 0) rhs.rightCols(rhs_columns) = b;
-    Eigen::MatrixXd solved = impl.llt.solve(rhs);
+    Eigen::MatrixXd solved = impl.solve(rhs);
     ++last_factor_solves_;
     if (impl.llt.info() != Eigen::Success || !solved.allFinite()) return false;
     if (new_columns > 0) {
@@ -423,7 +445,7 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
       x += solve_by_columns(r);
     } else {
       ++last_factor_solves_;
-      Eigen::MatrixXd solved = impl.llt.solve(r);
+      Eigen::MatrixXd solved = impl.solve(r);
       update_solved(solved);
       x += solved;
     }
@@ -434,7 +456,7 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
 
 Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   const Clock::time_point start = Clock::now();
-  Eigen::MatrixXd x = impl_->llt.solve(b);
+  Eigen::MatrixXd x = impl_->solve(b);
   if (b.cols() > 0) impl_->solve_seconds = seconds_between(start, Clock::now()) / static_cast<double>(b.cols());
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())
     throw ComputeError("sparse Cholesky solve failed or produced a non-finite value");

@@ -1,0 +1,270 @@
+#include "cleave/solve/supernodal_substitution.hpp"
+
+#include <cholmod.h>
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/enumerable_thread_specific.h>
+#include <tbb/parallel_for.h>
+#include <tbb/parallel_reduce.h>
+#include <tbb/partitioner.h>
+#include <tbb/task_arena.h>
+
+#include <algorithm>
+#include <queue>
+#include <utility>
+
+#include "cleave/core/error.hpp"
+
+namespace cleave {
+namespace {
+
+/// Subtrees per thread: enough that the heaviest one does not leave the other thread idle.
+constexpr int kSubtreesPerThread = 4;
+/// Supernodes above the subtrees with fewer entries than this run on one thread.
+constexpr Eigen::Index kParallelSupernodeEntries = Eigen::Index{1} << 16;
+/// Columns per block of a large supernode: each block's small triangle is solved on one thread,
+/// the rows below it over all.
+constexpr Eigen::Index kColumnBlock = 128;
+/// Entries of a large supernode's panel per parallel chunk of rows.
+constexpr Eigen::Index kChunkEntries = Eigen::Index{1} << 15;
+
+using ConstMatrixMap = Eigen::Map<const Eigen::MatrixXd>;
+
+/// One supernode of a CHOLMOD factor: columns [first, first + columns) of L, stored as a dense
+/// column-major rows x columns block whose row i is permuted row row_index[i] (the first
+/// `columns` rows are the supernode's own columns).
+struct Supernode {
+  Eigen::Index first = 0;
+  Eigen::Index columns = 0;
+  Eigen::Index rows = 0;
+  const int* row_index = nullptr;
+  const double* entries = nullptr;
+
+  ConstMatrixMap block() const { return {entries, rows, columns}; }
+};
+
+Supernode supernode_of(const cholmod_factor& f, const double* values, int s) {
+  const auto* super = static_cast<const int*>(f.super);
+  const auto* pi = static_cast<const int*>(f.pi);
+  const auto* px = static_cast<const int*>(f.px);
+  const auto* rows = static_cast<const int*>(f.s);
+  const auto u = static_cast<std::size_t>(s);
+  return {super[u], super[u + 1] - super[u], pi[u + 1] - pi[u], rows + pi[u], values + px[u]};
+}
+
+const double* values_of(const cholmod_factor& f) { return static_cast<const double*>(f.x); }
+
+/// Rows to give one parallel chunk of a panel `width` columns wide.
+Eigen::Index chunk_rows(Eigen::Index width) { return std::max<Eigen::Index>(64, kChunkEntries / std::max<Eigen::Index>(width, 1)); }
+
+/// L11 y1 = y1, then y(rows below) -= L21 y1: subtract_below(row, update) applies the update of
+/// one permuted row below the diagonal block. One thread.
+template <typename Subtract>
+void forward_supernode(const Supernode& sn, Eigen::MatrixXd& y, const Subtract& subtract_below) {
+  const ConstMatrixMap l = sn.block();
+  auto y1 = y.middleRows(sn.first, sn.columns);
+  l.topRows(sn.columns).triangularView<Eigen::Lower>().solveInPlace(y1);
+  const Eigen::Index below = sn.rows - sn.columns;
+  if (below == 0) return;
+  const Eigen::MatrixXd update = l.bottomRows(below) * y1;
+  for (Eigen::Index i = 0; i < below; ++i) subtract_below(sn.row_index[sn.columns + i], update.row(i));
+}
+
+/// y1 -= L21^T y(rows below), then L11^T y1 = y1. One thread.
+void backward_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
+  const ConstMatrixMap l = sn.block();
+  auto y1 = y.middleRows(sn.first, sn.columns);
+  const Eigen::Index below = sn.rows - sn.columns;
+  if (below > 0) {
+    Eigen::MatrixXd gathered(below, y.cols());
+    for (Eigen::Index i = 0; i < below; ++i) gathered.row(i) = y.row(sn.row_index[sn.columns + i]);
+    y1.noalias() -= l.bottomRows(below).transpose() * gathered;
+  }
+  l.topRows(sn.columns).triangularView<Eigen::Lower>().transpose().solveInPlace(y1);
+}
+
+/// forward_supernode of a large supernode: column blocks, the rows below each over all threads.
+void forward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
+  const ConstMatrixMap l = sn.block();
+  for (Eigen::Index j0 = 0; j0 < sn.columns; j0 += kColumnBlock) {
+    const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
+    auto yj = y.middleRows(sn.first + j0, width);
+    l.block(j0, j0, width, width).triangularView<Eigen::Lower>().solveInPlace(yj);
+    const Eigen::Index begin = j0 + width;
+    if (begin == sn.rows) continue;
+    const Eigen::MatrixXd yj_copy = yj;  // read by every chunk while they write other rows of y
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)),
+                      [&](const tbb::blocked_range<Eigen::Index>& range) {
+                        const Eigen::Index count = range.end() - range.begin();
+                        const Eigen::MatrixXd update = l.block(range.begin(), j0, count, width) * yj_copy;
+                        for (Eigen::Index i = 0; i < count; ++i) y.row(sn.row_index[range.begin() + i]) -= update.row(i);
+                      });
+  }
+}
+
+/// backward_supernode of a large supernode: column blocks from the last, each block's product
+/// with the rows below reduced over all threads.
+void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
+  const ConstMatrixMap l = sn.block();
+  const Eigen::Index blocks = (sn.columns + kColumnBlock - 1) / kColumnBlock;
+  for (Eigen::Index b = blocks - 1; b >= 0; --b) {
+    const Eigen::Index j0 = b * kColumnBlock;
+    const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
+    auto yj = y.middleRows(sn.first + j0, width);
+    const Eigen::Index begin = j0 + width;
+    if (begin < sn.rows) {
+      const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(width, y.cols());
+      const Eigen::MatrixXd product = tbb::parallel_reduce(
+          tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)), zero,
+          [&](const tbb::blocked_range<Eigen::Index>& range, Eigen::MatrixXd sum) {
+            const Eigen::Index count = range.end() - range.begin();
+            Eigen::MatrixXd gathered(count, y.cols());
+            for (Eigen::Index i = 0; i < count; ++i) gathered.row(i) = y.row(sn.row_index[range.begin() + i]);
+            sum.noalias() += l.block(range.begin(), j0, count, width).transpose() * gathered;
+            return sum;
+          },
+          [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& c) -> Eigen::MatrixXd { return a + c; });
+      yj -= product;
+    }
+    l.block(j0, j0, width, width).triangularView<Eigen::Lower>().transpose().solveInPlace(yj);
+  }
+}
+
+}  // namespace
+
+SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
+  if (!factor.is_super || !factor.is_ll)
+    throw InputError("supernodal substitution: expected a supernodal LL^T CHOLMOD factor (CHOLMOD_SUPERNODAL)");
+  if (factor.xtype != CHOLMOD_REAL || factor.dtype != CHOLMOD_DOUBLE || factor.itype != CHOLMOD_INT)
+    throw InputError("supernodal substitution: expected a factor with real double values and int indices");
+  order_ = factor.n;
+  supernode_count_ = factor.nsuper;
+  const auto* super = static_cast<const int*>(factor.super);
+  const auto* pi = static_cast<const int*>(factor.pi);
+  const auto* rows = static_cast<const int*>(factor.s);
+
+  // The supernodal elimination tree: a supernode's parent owns the first row below its columns.
+  std::vector<int> supernode_of_column(order_);
+  for (std::size_t s = 0; s < supernode_count_; ++s)
+    for (int k = super[s]; k < super[s + 1]; ++k) supernode_of_column[static_cast<std::size_t>(k)] = static_cast<int>(s);
+  std::vector<int> parent(supernode_count_, -1);
+  std::vector<double> subtree_entries(supernode_count_, 0.0);
+  std::vector<std::vector<int>> children(supernode_count_);
+  std::vector<int> roots;
+  for (std::size_t s = 0; s < supernode_count_; ++s) {
+    const int columns = super[s + 1] - super[s];
+    const int row_count = pi[s + 1] - pi[s];
+    subtree_entries[s] += static_cast<double>(columns) * row_count;
+    if (row_count > columns) {
+      const int below_first = *std::min_element(rows + pi[s] + columns, rows + pi[s + 1]);
+      parent[s] = supernode_of_column[static_cast<std::size_t>(below_first)];
+      if (parent[s] <= static_cast<int>(s)) throw InputError("supernodal substitution: the factor's supernodes are not in elimination order");
+      subtree_entries[static_cast<std::size_t>(parent[s])] += subtree_entries[s];
+      children[static_cast<std::size_t>(parent[s])].push_back(static_cast<int>(s));
+    } else {
+      roots.push_back(static_cast<int>(s));
+    }
+  }
+
+  // Split from the roots down until no subtree holds more than its share of the entries.
+  double total = 0;
+  for (const int r : roots) total += subtree_entries[static_cast<std::size_t>(r)];
+  const double share = total / (kSubtreesPerThread * std::max(1, tbb::this_task_arena::max_concurrency()));
+  const auto lighter = [&](int a, int b) { return subtree_entries[static_cast<std::size_t>(a)] < subtree_entries[static_cast<std::size_t>(b)]; };
+  std::priority_queue<int, std::vector<int>, decltype(lighter)> candidates(lighter, roots);
+  while (!candidates.empty()) {
+    const int s = candidates.top();
+    if (subtree_entries[static_cast<std::size_t>(s)] <= share || children[static_cast<std::size_t>(s)].empty()) break;
+    candidates.pop();
+    top_supernodes_.push_back(s);
+    for (const int c : children[static_cast<std::size_t>(s)]) candidates.push(c);
+  }
+  std::sort(top_supernodes_.begin(), top_supernodes_.end());
+
+  subtree_begin_.push_back(0);
+  for (; !candidates.empty(); candidates.pop()) {  // heaviest first
+    const std::size_t begin = subtree_order_.size();
+    subtree_order_.push_back(candidates.top());
+    for (std::size_t i = begin; i < subtree_order_.size(); ++i)
+      for (const int c : children[static_cast<std::size_t>(subtree_order_[i])]) subtree_order_.push_back(c);
+    std::sort(subtree_order_.begin() + static_cast<std::ptrdiff_t>(begin), subtree_order_.end());  // children first
+    subtree_begin_.push_back(subtree_order_.size());
+  }
+
+  top_slot_of_row_.assign(order_, -1);
+  for (const int s : top_supernodes_)
+    for (int k = super[s]; k < super[s + 1]; ++k) {
+      top_slot_of_row_[static_cast<std::size_t>(k)] = static_cast<int>(row_of_top_slot_.size());
+      row_of_top_slot_.push_back(k);
+    }
+}
+
+void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
+  const double* values = values_of(factor);
+  // Forward: the subtrees in parallel; their updates of the rows above them go to per-thread
+  // sums, subtracted before the top supernodes run.
+  const auto top_rows = static_cast<Eigen::Index>(row_of_top_slot_.size());
+  tbb::enumerable_thread_specific<Eigen::MatrixXd> above([&] { return Eigen::MatrixXd::Zero(top_rows, y.cols()); });
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      Eigen::MatrixXd& sums = above.local();
+                      for (std::size_t t = range.begin(); t < range.end(); ++t)
+                        for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i)
+                          forward_supernode(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
+                            const int slot = top_slot_of_row_[static_cast<std::size_t>(row)];
+                            if (slot >= 0)
+                              sums.row(slot) += update;
+                            else
+                              y.row(row) -= update;
+                          });
+                    },
+                    tbb::simple_partitioner());
+  above.combine_each([&](const Eigen::MatrixXd& sums) {
+    for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
+  });
+  for (const int s : top_supernodes_) {
+    const Supernode sn = supernode_of(factor, values, s);
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      forward_large_supernode(sn, y);
+    else
+      forward_supernode(sn, y, [&](int row, const auto& update) { y.row(row) -= update; });
+  }
+}
+
+void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
+  const double* values = values_of(factor);
+  // Backward: the top supernodes from the root down, then the subtrees in parallel (each reads
+  // the rows above it, already final, and writes only its own).
+  for (auto it = top_supernodes_.rbegin(); it != top_supernodes_.rend(); ++it) {
+    const Supernode sn = supernode_of(factor, values, *it);
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      backward_large_supernode(sn, y);
+    else
+      backward_supernode(sn, y);
+  }
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t t = range.begin(); t < range.end(); ++t)
+                        for (std::size_t i = subtree_begin_[t + 1]; i-- > subtree_begin_[t];)
+                          backward_supernode(supernode_of(factor, values, subtree_order_[i]), y);
+                    },
+                    tbb::simple_partitioner());
+}
+
+void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eigen::MatrixXd> b) const {
+  if (static_cast<std::size_t>(b.rows()) != order_ || factor.n != order_ || factor.nsuper != supernode_count_)
+    throw InputError(fmt::format("supernodal substitution: right-hand side has {} rows and the factor order {}; the schedule "
+                                 "was made for order {} with {} supernodes",
+                                 b.rows(), factor.n, order_, supernode_count_));
+  const auto* perm = static_cast<const int*>(factor.Perm);
+  const auto permuted = [&](Eigen::Index k) { return perm != nullptr ? perm[k] : k; };
+  const auto n = static_cast<Eigen::Index>(order_);
+  Eigen::MatrixXd y(n, b.cols());
+  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(permuted(k));
+
+  forward(factor, y);
+  backward(factor, y);
+  for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
+}
+
+}  // namespace cleave
