@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <fmt/format.h>
+#include <cmath>
 #include <limits>
 
 #include "cleave/core/error.hpp"
@@ -104,9 +105,10 @@ TEST_P(AbdomenEquilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest)
   d.equilibration = Equilibration::growth;
   const DesignResult result = design_residual_stress(m, d);
 
-  // 2.05e-12 measured with w_E = 1 (the equilibration's shift 1e-10; below 1e-12 with 1e-8, which
-  // needed two to four times the iterations); the body's rest and Hoger's mean are checked below.
-  EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 1e-11 : 3e-12);
+  // The equilibration stops at ||T sigma|| <= 1e-11 ||T sigma_d|| (its rounding floor is near
+  // 1e-12): measured 1.2e-11 (w_E = 0) and 3.7e-12 (w_E = 1) in this scale-free measure (2.05e-12
+  // with w_E = 1 while it iterated to the floor); the body's rest and Hoger's mean are checked below.
+  EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 5e-11 : 1e-11);
   EXPECT_GT(result.residual_designed, 1e-2);
   const double size = m.size_mm();
   EXPECT_GT(max_displacement_mm(m, result.designed_kPa), 1e-3 * size);
@@ -151,10 +153,57 @@ TEST(Equilibration, WithTheRimHeldTheSkinKeepsItsLangerTension) {
   for (VertexId v = 0; v < m.volume.vertex_count(); ++v)
     if (!held[static_cast<std::size_t>(v)]) free_force = std::max(free_force, forces.segment<3>(3 * v).cwiseAbs().maxCoeff());
   EXPECT_LT(free_force, 1e-9 * designed_forces.cwiseAbs().maxCoeff());
-  EXPECT_LT(result.residual_final, 1e-12);
+  EXPECT_LT(result.residual_final, 1e-11);  // measured 3.7e-12 (the stopping rule: 1e-11 of ||T sigma_d||)
   const double size = m.size_mm();
   EXPECT_GT(max_displacement_mm(m, result.designed_kPa, d.held_vertices), 1e-2 * size);
   EXPECT_LT(max_displacement_mm(m, result.stress_kPa, d.held_vertices), 1e-6 * size);
+}
+
+/// A tube's designed stress: Langer tension 20 kPa winding with z, turned further inside a
+/// Gaussian spot around `spot_mm` (the kind of change a stroke edit makes), 10 kPa across.
+std::vector<Vec6> spotted_design_kPa(const TissueModel& m, const Vec3& spot_mm) {
+  std::vector<Vec6> out(static_cast<std::size_t>(m.volume.cell_count()));
+  for (CellId c = 0; c < m.volume.cell_count(); ++c) {
+    const Vec3 p = m.volume.cell_center_mm(c);
+    const double angle = 0.05 * p.z() + 0.8 * std::exp(-0.02 * (p - spot_mm).squaredNorm());
+    Vec6 s;
+    s << 20.0 * std::cos(angle) * std::cos(angle), 20.0 * std::sin(angle) * std::sin(angle), 10.0,
+        20.0 * std::sin(angle) * std::cos(angle), 0.0, 0.0;
+    out[static_cast<std::size_t>(c)] = s;
+  }
+  return out;
+}
+
+// Edits: warm-started from the last solve, with the soft modes (what CG corrected after its first
+// step) of the earlier ones. Each edit equals a fresh equilibration. A stroke dragged back and forth
+// (or undone and redone) revisits designs: once one round taught the modes, each edit needs one solve
+// with the factor; plain CG from the warm start needs two to four on this shell (measured).
+TEST(Equilibration, EditsLearnTheSoftModesAndEqualAFreshEquilibration) {
+  const TissueModel m = test::builtin_model("abdomen");
+  const Vec3 c = m.volume.grid().origin_mm + 0.5 * m.volume.grid().extent_mm();
+  const std::vector<Vec3> spots = {c + Vec3(-30.0, 5.0, 0.0), c + Vec3(0.0, -5.0, 3.0), c + Vec3(25.0, 0.0, -3.0)};
+  std::vector<std::vector<Vec6>> designs, fresh;
+  for (const Vec3& spot : spots) {
+    designs.push_back(spotted_design_kPa(m, spot));
+    fresh.push_back(equilibrate_stress(m, designs.back()).stress_kPa);
+  }
+  StressEquilibrator kept(m);
+  (void)kept.equilibrate(spotted_design_kPa(m, c));
+  int late_solves = 0;
+  constexpr int kRounds = 3;
+  for (int edit = 0; edit < kRounds * 3; ++edit) {
+    const std::size_t which = static_cast<std::size_t>(edit % 3);
+    const EquilibrationResult edited = kept.equilibrate(designs[which]);
+    EXPECT_LE(edited.force_reduction, 1e-10);
+    double difference = 0, largest = 0;
+    for (std::size_t i = 0; i < edited.stress_kPa.size(); ++i) {
+      difference = std::max(difference, (edited.stress_kPa[i] - fresh[which][i]).cwiseAbs().maxCoeff());
+      largest = std::max(largest, fresh[which][i].cwiseAbs().maxCoeff());
+    }
+    EXPECT_LT(difference, 1e-8 * largest) << "edit " << edit;
+    if (edit >= 3) late_solves += edited.refinement_steps;
+  }
+  EXPECT_EQ(late_solves, (kRounds - 1) * 3);
 }
 
 TEST(Equilibration, ABalancedFieldIsLeftAsItIs) {

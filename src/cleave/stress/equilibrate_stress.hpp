@@ -14,11 +14,15 @@
 // ~1e-6 of the mean diagonal. The right-hand side lies in the range of Kc, and the null modes do
 // not change D Bc u, but a stationary refinement with a shifted factor stalls on the soft modes
 // (the old code: 4.6e-7 after 100 steps on the abdomen). Here the factor of Kc + eps I
-// (eps = 1e-8 of the mean diagonal, computed once per topology) preconditions conjugate
+// (eps = 1e-10 of the mean diagonal, computed once per topology) preconditions conjugate
 // gradients on Kc itself: the few eigenvalues of the preconditioned operator that are not close
-// to 1 (soft and near-hourglass modes) are what CG removes in a handful of iterations (9 on the
-// abdomen to 4e-12). The best iterate is kept, since rounding in the null space makes CG drift
-// after convergence.
+// to 1 (soft and near-hourglass modes) are what CG removes in a handful of iterations. The best
+// iterate is kept, since rounding in the null space makes CG drift after convergence; the solve
+// stops at ||T sigma|| <= 1e-11 ||T sigma_d|| (the rounding floor is near 1e-12).
+// Edits: each solve starts from the last displacement, and its first step minimizes the energy
+// over the factor's correction and the soft modes learned from earlier solves (what CG corrected
+// after its first step, Kc-orthonormal, at most 16): an edit back to an earlier design (a drag
+// back and forth, undo, redo) needs one solve with the factor instead of two to four.
 // Consequences: the uncut, unsupported body does not move under sigma, and the volume average of
 // sigma is exactly zero (Hoger's theorem, section 3.1), since T sigma = 0 for a field on cubes
 // implies sum_c V sigma_c = 0.
@@ -37,7 +41,7 @@ namespace cleave {
 struct EquilibrationResult {
   std::vector<Vec6> stress_kPa;         ///< self-balanced field, one per cell
   double force_reduction = 0;           ///< ||T sigma|| / ||T sigma_d|| over free vertices (0 when sigma_d was balanced)
-  int refinement_steps = 0;             ///< preconditioned CG iterations
+  int refinement_steps = 0;             ///< solves with the factor (preconditioned CG iterations)
 };
 
 class StressEquilibrator {
@@ -53,7 +57,8 @@ class StressEquilibrator {
 
   /// Throws InputError when `designed_kPa` has the wrong size or non-finite values; ComputeError
   /// when ||T sigma|| / ||T sigma_d|| stays above 1e-10 (never returns NaN). Starts from the
-  /// displacement of the previous call (a small edit needs few iterations).
+  /// displacement of the previous call and the soft modes of the earlier ones (a small edit
+  /// needs one or two solves with the factor).
   EquilibrationResult equilibrate(std::span<const Vec6> designed_kPa);
 
  private:
