@@ -196,8 +196,8 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
     impl_->values.clear();
     throw ComputeError("sparse Cholesky factorization failed: the design system is not positive definite");
   }
-  if (!impl_->substitution) impl_->substitution.emplace(*impl_->llt.factor());
   impl_->factor_seconds = seconds_between(start, Clock::now());
+  if (!impl_->substitution) impl_->substitution.emplace(*impl_->llt.factor());
   impl_->values.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
   impl_->diagonal = a.diagonal();
   impl_->low_rank_columns.resize(0, 0);
