@@ -106,13 +106,17 @@ TEST(SupernodalSubstitution, EqualsCholmodSolveWithSubtreesAndLargeTopSupernodes
   EXPECT_LT(relative_difference(substituted(sub, chol.factor(), several), chol.cholmod_solution(several)), 1e-12);
 }
 
-TEST(SupernodalSubstitution, OneThreadGivesTheSameSolution) {
+// The same schedule gives the same bits however the threads share the work: repeated solves,
+// and a solve on one thread (the equilibration's stopping test sits near rounding, so a
+// scheduling-dependent result would change its iteration count from run to run).
+TEST(SupernodalSubstitution, GivesTheSameBitsOnAnyNumberOfThreads) {
   test::LinearSystem s = block_system();
   CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   const Eigen::MatrixXd all_threads = substituted(sub, chol.factor(), s.b);
+  for (int repeat = 0; repeat < 5; ++repeat) EXPECT_TRUE(substituted(sub, chol.factor(), s.b) == all_threads);
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
-  EXPECT_LT(relative_difference(substituted(sub, chol.factor(), s.b), all_threads), 1e-14);
+  EXPECT_TRUE(substituted(sub, chol.factor(), s.b) == all_threads);
 }
 
 TEST(SupernodalSubstitution, KeepsItsScheduleAcrossRefactorizations) {

@@ -3,7 +3,6 @@
 #include <cholmod.h>
 #include <fmt/format.h>
 #include <tbb/blocked_range.h>
-#include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 #include <tbb/partitioner.h>
@@ -114,7 +113,8 @@ void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
     const Eigen::Index begin = j0 + width;
     if (begin < sn.rows) {
       const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(width, y.cols());
-      const Eigen::MatrixXd product = tbb::parallel_reduce(
+      // Deterministic: the chunks and their summation order do not depend on the scheduling.
+      const Eigen::MatrixXd product = tbb::parallel_deterministic_reduce(
           tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)), zero,
           [&](const tbb::blocked_range<Eigen::Index>& range, Eigen::MatrixXd sum) {
             const Eigen::Index count = range.end() - range.begin();
@@ -123,7 +123,8 @@ void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
             sum.noalias() += l.block(range.begin(), j0, count, width).transpose() * gathered;
             return sum;
           },
-          [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& c) -> Eigen::MatrixXd { return a + c; });
+          [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& c) -> Eigen::MatrixXd { return a + c; },
+          tbb::simple_partitioner());
       yj -= product;
     }
     l.block(j0, j0, width, width).triangularView<Eigen::Lower>().transpose().solveInPlace(yj);
@@ -201,14 +202,16 @@ SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
 
 void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
   const double* values = values_of(factor);
-  // Forward: the subtrees in parallel; their updates of the rows above them go to per-thread
-  // sums, subtracted before the top supernodes run.
+  // Forward: the subtrees in parallel; each one's updates of the rows above it go to its own
+  // sums, subtracted in subtree order before the top supernodes run (the same rounding whatever
+  // thread ran which subtree).
   const auto top_rows = static_cast<Eigen::Index>(row_of_top_slot_.size());
-  tbb::enumerable_thread_specific<Eigen::MatrixXd> above([&] { return Eigen::MatrixXd::Zero(top_rows, y.cols()); });
+  std::vector<Eigen::MatrixXd> above(subtree_count());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
-                      Eigen::MatrixXd& sums = above.local();
-                      for (std::size_t t = range.begin(); t < range.end(); ++t)
+                      for (std::size_t t = range.begin(); t < range.end(); ++t) {
+                        Eigen::MatrixXd& sums = above[t];
+                        sums.setZero(top_rows, y.cols());
                         for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i)
                           forward_supernode(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
                             const int slot = top_slot_of_row_[static_cast<std::size_t>(row)];
@@ -217,11 +220,11 @@ void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::Matrix
                             else
                               y.row(row) -= update;
                           });
+                      }
                     },
                     tbb::simple_partitioner());
-  above.combine_each([&](const Eigen::MatrixXd& sums) {
+  for (const Eigen::MatrixXd& sums : above)
     for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
-  });
   for (const int s : top_supernodes_) {
     const Supernode sn = supernode_of(factor, values, s);
     if (sn.rows * sn.columns >= kParallelSupernodeEntries)

@@ -12,7 +12,8 @@
 //
 // The schedule depends only on the factor's structure (supernodes, their rows, the permutation):
 // it stays valid across numeric refactorizations with the same analysis. Results equal
-// cholmod_solve(CHOLMOD_A, ...) to rounding (the same operations, other summation order).
+// cholmod_solve(CHOLMOD_A, ...) to rounding (the same operations, other summation order) and do
+// not depend on which thread ran what: the same schedule gives the same bits.
 #include <Eigen/Core>
 #include <cstddef>
 #include <vector>
