@@ -210,21 +210,23 @@ void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::Matrix
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                        Eigen::MatrixXd& sums = above[t];
-                        sums.setZero(top_rows, y.cols());
+                        Eigen::MatrixXd& sums = above[t];  // made at its first update: a root (a held dof) has none
                         for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i)
                           forward_supernode(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
                             const int slot = top_slot_of_row_[static_cast<std::size_t>(row)];
-                            if (slot >= 0)
+                            if (slot >= 0) {
+                              if (sums.size() == 0) sums.setZero(top_rows, y.cols());
                               sums.row(slot) += update;
-                            else
+                            } else {
                               y.row(row) -= update;
+                            }
                           });
                       }
                     },
                     tbb::simple_partitioner());
   for (const Eigen::MatrixXd& sums : above)
-    for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
+    if (sums.size() > 0)
+      for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
   for (const int s : top_supernodes_) {
     const Supernode sn = supernode_of(factor, values, s);
     if (sn.rows * sn.columns >= kParallelSupernodeEntries)
