@@ -3,6 +3,8 @@
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
+#include <random>
+#include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/atomic_file.hpp"
@@ -20,6 +22,7 @@
 #include "cleave/viz/wound_measures.hpp"
 #include "studio/cut_face_values.hpp"
 #include "studio/finite_message.hpp"
+#include "studio/packed_array.hpp"
 
 namespace cleave::studio {
 namespace {
@@ -30,9 +33,6 @@ using Clock = std::chrono::steady_clock;
 constexpr double kPreviewRadiusCells = 2.5;   ///< incision radius
 constexpr double kPreviewDepthCells = 2.0;    ///< incision depth
 constexpr double kPreviewSpacingCells = 9.0;  ///< least distance between centres (> diameter + 1 cell)
-
-constexpr double kRounding = 1e-3;       ///< mm, kPa: result fields
-constexpr double kFrameRounding = 1e-2;  ///< mm: positions in frames and streamlines (0.01 mm)
 
 // The wound opening after a cut: Newmark steps streamed to the page, one frame per step.
 constexpr int kOpeningFrames = 8;
@@ -52,16 +52,6 @@ StressDesign design_settings(const CaseFile& case_file) {
   const nlohmann::json* section = case_file.section("design");
   if (!section || !section->is_object()) return StressDesign{};
   return parse_design_settings_json(*section, case_file.at("design"));
-}
-
-/// Rounds to `step` (mm, kPa): the page does not need more and the messages stay small.
-double rounded_to(double v, double step) { return std::round(v / step) * step; }
-
-nlohmann::json float_array(const std::vector<float>& values, double step = kRounding) {
-  nlohmann::json a = nlohmann::json::array();
-  a.get_ref<nlohmann::json::array_t&>().reserve(values.size());
-  for (float v : values) a.push_back(rounded_to(static_cast<double>(v), step));
-  return a;
 }
 
 /// Triangle indices of `surface` without the hidden plugs of the round incisions.
@@ -101,16 +91,34 @@ std::vector<float> residual_per_surface_vertex(const LinkedVolume& volume, const
 
 StudioCompute::StudioCompute(const StudioSession& session, std::function<void(std::string)> send)
     : session_(session), send_(std::move(send)) {
+  std::random_device entropy;
+  server_token_ = fmt::format("{:08x}{:08x}", entropy(), entropy());
   worker_ = std::make_unique<FieldWorker>(
       [this](FieldWorker::Result r) {
         // How much work the edits caused: a burst of edits starts fewer computations than edits
         // (the worker drops stale ones), which the page and its tests can see.
-        if (r.message.value("type", "") == "result")
-          r.message["computations"] = {{"started", worker_->jobs_started()}, {"published", ++results_published_}};
+        if (r.message.value("type", "") != "result") {
+          send_(r.message.dump());
+          return;
+        }
+        r.message["computations"] = {{"started", worker_->jobs_started()}, {"published", ++results_published_}};
+        // The connected clients hold the triangles of the surface they were last sent (every
+        // result reaches every client; one that connects later gets latest_result_ in full).
+        nlohmann::json& surface = r.message["surface"];
+        nlohmann::json triangles;
+        if (surface.is_object()) {
+          const std::string id = surface.value("id", "");
+          if (id == broadcast_surface_id_ && surface.contains("triangles")) {
+            triangles = std::move(surface["triangles"]);
+            surface.erase("triangles");
+          }
+          broadcast_surface_id_ = id;
+        }
         std::string text = r.message.dump();
+        if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
         {
           std::lock_guard lock(latest_mutex_);
-          if (r.message.value("type", "") == "result") latest_result_ = text;
+          latest_result_ = std::move(r.message);
         }
         send_(std::move(text));
       },
@@ -125,8 +133,8 @@ void StudioCompute::design_changed(const DesignState& design, std::uint64_t seq)
 
 std::vector<std::string> StudioCompute::welcome_messages() const {
   std::lock_guard lock(latest_mutex_);
-  if (latest_result_.empty()) return {};
-  return {latest_result_};
+  if (latest_result_.is_null()) return {};
+  return {latest_result_.dump()};
 }
 
 void StudioCompute::prepare(const FieldWorker::Context& ctx) {
@@ -228,6 +236,7 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   held_cut_ = held_vertices(*preview_model_, simulation_, plan_.hidden_cells());
   cut_face_layout_ = cut_face_layout(*body_surface_, *preview_model_, *preview_surface_);
   cut_key_ = key;
+  surface_id_ = fmt::format("{}-{}", server_token_, ++surfaces_built_);
   return true;
 }
 
@@ -256,8 +265,8 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     positions.reserve(3 * x.size());
     for (const Vec3& p : x)
       for (int a = 0; a < 3; ++a) positions.push_back(static_cast<float>(p[a]));
-    frame["positions_mm"] = float_array(positions, kFrameRounding);
-    if (i == 0) frame["triangles"] = triangles;
+    frame["positions_mm"] = packed_floats(positions);
+    if (i == 0) frame["triangles"] = packed_indices(triangles);
     std::size_t scalpel = 0;
     for (const Cut& c : design.cuts) {
       if (c.kind != CutKind::scalpel || scalpel >= plan_.scalpel_paths.size()) continue;
@@ -351,24 +360,28 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     langer.push_back(static_cast<float>(fields->eigenvalues_kPa[c][0]));
     cross.push_back(static_cast<float>(fields->eigenvalues_kPa[c][1]));
   }
-  message["surface"] = {{"positions_mm", float_array(positions)}, {"triangles", visible_triangles(surface, plan_)}};
+  message["surface"] = {{"id", surface_id_},
+                        {"positions_mm", packed_floats(positions)},
+                        {"triangles", packed_indices(visible_triangles(surface, plan_))}};
   nlohmann::json f = nlohmann::json::object();
-  if (fields) f["direction"] = float_array(direction);
+  if (fields) f["direction"] = packed_floats(direction);
   if (!langer.empty()) {
-    f["langer_kPa"] = float_array(langer);
-    f["cross_kPa"] = float_array(cross);
+    f["langer_kPa"] = packed_floats(langer);
+    f["cross_kPa"] = packed_floats(cross);
   }
   if (has_stress) {
     if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
-    f["residual_kPa"] = float_array(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices));
+    f["residual_kPa"] = packed_floats(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices));
   }
-  if (!displacement_mm_.empty()) f["displacement_mm"] = float_array(moved);
+  if (!displacement_mm_.empty()) f["displacement_mm"] = packed_floats(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).
   if (cut_face_layout_.any) {
-    f["cut_depth"] = float_array(cut_face_layout_.depth);
-    f["traction_kPa"] = float_array(cut_face_traction_kPa(cut_face_layout_, surface, stress_kPa_));
+    f["cut_depth"] = packed_floats(cut_face_layout_.depth);
+    f["traction_kPa"] = packed_floats(cut_face_traction_kPa(cut_face_layout_, surface, stress_kPa_));
   }
   message["fields"] = f;
+  timings["surface"] = ms_since(t);
+  t = Clock::now();
   if (fields && !design.strokes.empty()) {
     StreamlineOptions so;
     so.seed_stride_cells = kStreamlineSeedStride;
@@ -378,10 +391,13 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
       std::vector<float> flat;
       for (const Vec3& p : line)
         for (int a = 0; a < 3; ++a) flat.push_back(static_cast<float>(p[a]));
-      lines.push_back(float_array(flat, kFrameRounding));
+      lines.push_back(packed_floats(flat));
     }
     message["streamlines_mm"] = lines;
   }
+
+  if (message.contains("streamlines_mm")) timings["streamlines"] = ms_since(t);
+  t = Clock::now();
 
   // 5. Measurements: incision openings and wound widths.
   nlohmann::json incisions = nlohmann::json::array();
@@ -389,14 +405,17 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   nlohmann::json flaps = nlohmann::json::array();
   if (!displacement_mm_.empty()) {
     const double h = model.volume.grid().cell_size_mm;
-    for (const IncisionFrame& frame : plan_.incisions) {
+    // Each incision is measured on its own (the surface and the displacement are only read).
+    std::vector<nlohmann::json> measured(plan_.incisions.size());
+    tbb::parallel_for(std::size_t{0}, plan_.incisions.size(), [&](std::size_t i) {
+      const IncisionFrame& frame = plan_.incisions[i];
       // The designed Langer direction under the incision is the reference of the long axis.
       std::optional<TangentDirection> reference;
       CellId c = model.volume.cell_containing(frame.centre_mm - 0.5 * h * frame.normal);
       if (c == kNone) c = model.volume.cell_containing(frame.centre_mm - h * frame.normal);
       if (c != kNone && fields) reference = TangentDirection{fields->frames[static_cast<std::size_t>(c)].langer, 1.0};
       const auto m = measure_incision(*cut_body_surface_, displacement_mm_, frame, reference);
-      if (!m) continue;
+      if (!m) return;
       nlohmann::json j = {{"centre_mm", {frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()}},
                           {"opening_mm", m->opening_mm},
                           {"gap_mm", m->gap_mm},
@@ -404,8 +423,10 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
                           {"semi_minor_mm", m->outer.semi_minor},
                           {"axis_ratio", m->outer.axis_ratio()}};
       if (m->langer_angle_deg) j["langer_angle_deg"] = *m->langer_angle_deg;
-      incisions.push_back(std::move(j));
-    }
+      measured[i] = std::move(j);
+    });
+    for (nlohmann::json& j : measured)
+      if (!j.is_null()) incisions.push_back(std::move(j));
     std::size_t scalpel = 0;
     for (const Cut& c : design.cuts) {
       if (c.kind != CutKind::scalpel || scalpel >= plan_.scalpel_paths.size()) continue;
@@ -429,7 +450,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   message["bounding_box_mm"] = {{lo.x(), lo.y(), lo.z()}, {hi.x(), hi.y(), hi.z()}};
   message["cell_size_mm"] = model.volume.grid().cell_size_mm;
   message["cells"] = model.volume.cell_count();
-  timings["surface"] = ms_since(t);
+  timings["measurements"] = ms_since(t);
   timings["total"] = ms_since(t0);
   message["timings_ms"] = timings;
   // Nothing non-finite leaves the server: a NaN anywhere turns the result into an error naming

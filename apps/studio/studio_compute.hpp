@@ -33,7 +33,9 @@ class StudioCompute {
 
   /// Starts recomputing for `design` (seq = the session's seq); a newer call supersedes it.
   void design_changed(const DesignState& design, std::uint64_t seq);
-  /// The latest result message (the mesh and fields) for a newly connected client.
+  /// The latest result message (the mesh and fields) for a newly connected client, with its
+  /// triangles (a result sent to connected clients leaves them out when its surface is the one
+  /// they already hold: docs/studio.md).
   std::vector<std::string> welcome_messages() const;
   /// Writes the latest result in `format` to `file`.
   void export_result(ExportFormat format, const std::filesystem::path& file) const;
@@ -70,6 +72,10 @@ class StudioCompute {
   DesignResult directions_only_;
   SparseMatrix divergence_;                           ///< T of the uncut model, for the residual display
   std::string cut_key_;                               ///< what preview_model_ was cut with
+  /// Names preview_surface_ in the messages ("surface"/"id"): this server's random token and a
+  /// count of the surfaces built, so a page never takes another server's triangles for these.
+  std::string surface_id_;
+  std::uint64_t surfaces_built_ = 0;
   CutPlan plan_;
   std::vector<Vec6> stress_kPa_;                      ///< of the last design (per cell), for exports
   std::vector<Vec3> displacement_mm_;                 ///< of the last preview (per vertex of preview_model_)
@@ -91,8 +97,10 @@ class StudioCompute {
     SurfaceMesh mesh;                          ///< deformed render surface
   };
   std::uint64_t results_published_ = 0;  ///< worker thread
+  std::string broadcast_surface_id_;     ///< worker thread: the surface whose triangles the clients last got
+  std::string server_token_;             ///< random, per StudioCompute
   mutable std::mutex latest_mutex_;
-  std::string latest_result_;
+  nlohmann::json latest_result_;  ///< in full (with its triangles); dumped for each new client
   ExportSnapshot latest_export_;
   std::unique_ptr<FieldWorker> worker_;
 };

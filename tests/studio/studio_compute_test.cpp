@@ -4,6 +4,8 @@
 // along Langer's lines) also away from the control points; a case file keeps its own settings.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
@@ -11,6 +13,7 @@
 
 #include "cleave/pipeline/demo_case.hpp"
 #include "studio/finite_message.hpp"
+#include "studio/packed_array.hpp"
 #include "studio/studio_compute.hpp"
 #include "studio/studio_main.hpp"
 #include "studio/studio_session.hpp"
@@ -116,6 +119,66 @@ TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
   EXPECT_GE(far, 3);
   EXPECT_EQ(far_open, far) << "incisions away from the control points open by more than 0.3 mm";
   EXPECT_GE(along, static_cast<int>(incisions.size()) * 3 / 4) << "long axes along Langer's lines";
+}
+
+TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGetsThemAll) {
+  StudioSession session(fresh_folder("lean"), bare_model_case(kCoarseAbdomen));
+  const json demo = abdomen_demo_case(session.model(), DemoStress::designed);
+  std::mutex m;
+  std::vector<json> results;
+  StudioCompute compute(session, [&](std::string text) {
+    json message = json::parse(text);
+    std::lock_guard lock(m);
+    if (message["type"] == "result") results.push_back(std::move(message));
+  });
+  const auto edit = [&](const json& e) {
+    session.apply_edit(e);
+    compute.design_changed(session.design(), session.seq());
+    compute.wait_idle();
+  };
+  edit({{"cmd", "add_stroke"}, {"points_mm", demo["design"]["strokes"][0]["points"]}});
+  edit({{"cmd", "add_stroke"}, {"points_mm", demo["design"]["strokes"][1]["points"]}});
+  const json& cut = demo["cuts"][0];
+  edit({{"cmd", "add_cut"}, {"kind", "scalpel"}, {"path_mm", cut["path_mm"]}, {"depth_mm", cut["depth_mm"]}});
+  edit({{"cmd", "undo"}});
+  compute.wait_idle();
+  std::lock_guard lock(m);  // the worker is idle: nothing sends any more
+  ASSERT_EQ(results.size(), 4u);
+  const json& first = results[0]["surface"];
+  const json& second = results[1]["surface"];
+  const json& third = results[2]["surface"];
+  ASSERT_TRUE(first.contains("triangles"));
+  EXPECT_FALSE(second.contains("triangles")) << "a stroke does not change the surface: its triangles are not sent again";
+  EXPECT_EQ(second["id"], first["id"]);
+  ASSERT_TRUE(third.contains("triangles")) << "a cut makes a new surface";
+  EXPECT_NE(third["id"], first["id"]);
+
+  // The packed arrays describe one mesh: every index names a vertex, every field has one value per vertex.
+  const std::vector<float> positions = unpacked_floats(second["positions_mm"]);
+  const std::vector<std::uint32_t> triangles = unpacked_indices(first["triangles"]);
+  ASSERT_EQ(positions.size() % 3, 0u);
+  ASSERT_EQ(triangles.size() % 3, 0u);
+  ASSERT_GE(triangles.size(), 3000u);
+  const auto vertices = static_cast<std::uint32_t>(positions.size() / 3);
+  EXPECT_LT(*std::max_element(triangles.begin(), triangles.end()), vertices);
+  EXPECT_TRUE(std::all_of(positions.begin(), positions.end(), [](float v) { return std::isfinite(v); }));
+  const std::vector<float> direction = unpacked_floats(results[1]["fields"]["direction"]);
+  ASSERT_EQ(direction.size(), positions.size());
+  for (std::size_t v = 0; v < vertices; ++v) {
+    const double length = std::hypot(direction[3 * v], direction[3 * v + 1], direction[3 * v + 2]);
+    EXPECT_NEAR(length, 1.0, 1e-5) << "a unit Langer direction at surface vertex " << v;
+    if (std::abs(length - 1.0) > 1e-5) break;
+  }
+
+  // A client that connects now gets the latest result (the undo's) with its triangles.
+  const std::vector<std::string> welcome = compute.welcome_messages();
+  ASSERT_EQ(welcome.size(), 1u);
+  const json latest = json::parse(welcome[0]);
+  EXPECT_EQ(latest["seq"], results[3]["seq"]);
+  ASSERT_TRUE(results[3]["surface"].contains("triangles")) << "undoing the cut returns to a surface the clients do not hold";
+  EXPECT_NE(results[3]["surface"]["id"], first["id"]) << "rebuilt, so named anew";
+  ASSERT_TRUE(latest["surface"].contains("triangles")) << "the latest result keeps its triangles for new clients";
+  EXPECT_EQ(unpacked_indices(latest["surface"]["triangles"]), triangles) << "the uncut surface again";
 }
 
 }  // namespace

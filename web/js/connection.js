@@ -1,5 +1,8 @@
 // The WebSocket to the studio server: request/reply matching by "req", pushes dispatched by
-// "type", and automatic reconnection (a client that reconnects says hello and resumes).
+// "type", and automatic reconnection (a client that reconnects says hello and resumes). Packed
+// arrays (packed.js) arrive as typed arrays.
+import { unpackMessage } from './packed.js';
+
 export class Connection {
   constructor(url, onMessage, onStatus) {
     this.url = url;
@@ -21,7 +24,7 @@ export class Connection {
     };
     ws.onmessage = (event) => {
       let message;
-      try { message = JSON.parse(event.data); } catch { return; }
+      try { message = unpackMessage(JSON.parse(event.data)); } catch { return; }
       if (message.req !== undefined && this.pending.has(message.req)) {
         const { resolve, reject } = this.pending.get(message.req);
         this.pending.delete(message.req);

@@ -27,11 +27,31 @@ function setMessage(text, isError = false) {
   if (isError) app.lastError = text;
 }
 
+/// The server leaves a result's triangles out when its surface (surface.id) is the one it sent
+/// before; they are taken from the last result that had them. A result for a surface this page
+/// never got (it connected in between) is skipped and the full latest result asked for (hello).
+const surfaceCache = { id: null, triangles: null };
+function withTriangles(m) {
+  const s = m.surface;
+  if (s.triangles) {
+    surfaceCache.id = s.id;
+    surfaceCache.triangles = s.triangles;
+    return true;
+  }
+  if (s.id !== undefined && s.id === surfaceCache.id) {
+    s.triangles = surfaceCache.triangles;
+    return true;
+  }
+  connection.request('hello').catch(() => {});
+  return false;
+}
+
 function onMessage(m) {
   if (m.type === 'state') {
     app.state = m;
     refreshDesign();
   } else if (m.type === 'result') {
+    if (!withTriangles(m)) return;
     app.result = m;
     app.resultCount++;
     app.resultSeqs.push(m.seq);
@@ -79,7 +99,7 @@ function onMessage(m) {
 }
 
 const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', equilibration: 'equilibration', cuts: 'cut model', opening: 'wound opening (frames)',
-  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', total: 'edit to picture' };
+  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', streamlines: 'streamlines', measurements: 'incision and wound measurements', total: 'edit to picture' };
 function showTimings(t) {
   const rows = Object.keys(STAGES).filter((k) => t[k] !== undefined).map((k) => {
     const tr = document.createElement('tr');

@@ -5,6 +5,9 @@ import * as THREE from 'three';
 import { OrbitControls } from 'three/addons/OrbitControls.js';
 import { rampColor, rampCss } from './colormap.js';
 
+/// three.js takes plain index arrays but wants typed ones (the server's packed triangles) wrapped.
+const indexAttribute = (triangles) => (ArrayBuffer.isView(triangles) ? new THREE.BufferAttribute(triangles, 1) : triangles);
+
 const BODY_COLOR = [0.93, 0.78, 0.70];
 const STROKE_COLOR = 0xff3b30;
 const CUT_COLOR = 0x111111;
@@ -63,7 +66,7 @@ export class Viewer {
     const s = result.surface;
     const geometry = new THREE.BufferGeometry();
     geometry.setAttribute('position', new THREE.Float32BufferAttribute(s.positions_mm, 3));
-    geometry.setIndex(s.triangles);
+    geometry.setIndex(indexAttribute(s.triangles));
     geometry.computeVertexNormals();
     geometry.setAttribute('color', new THREE.Float32BufferAttribute(new Float32Array(s.positions_mm.length), 3));
     if (this.mesh) { this.scene.remove(this.mesh); this.mesh.geometry.dispose(); }
@@ -84,7 +87,7 @@ export class Viewer {
     if (triangles) {
       const g = new THREE.BufferGeometry();
       g.setAttribute('position', new THREE.Float32BufferAttribute(positions, 3));
-      g.setIndex(triangles);
+      g.setIndex(indexAttribute(triangles));
       const colors = new Float32Array(positions.length);
       for (let i = 0; i < colors.length; i += 3) colors.set(BODY_COLOR, i);
       g.setAttribute('color', new THREE.Float32BufferAttribute(colors, 3));
@@ -183,9 +186,13 @@ export class Viewer {
       legend.querySelector('.title').textContent = !shown ? `${scalar[1]}: not computed yet`
         : uniform ? `${scalar[1]} (${scalar[2]}): uniform ${lo.toFixed(2)}` : `${scalar[1]} (${scalar[2]})`;
       legend.querySelector('.ramp').style.background = rampCss(scalar[3]);
-      const digits = hi - lo < 0.1 ? 4 : 2;
-      legend.querySelector('.lo').textContent = shown ? `${lo.toFixed(digits)}` : '';
-      legend.querySelector('.hi').textContent = shown ? `${(uniform ? lo : hi).toFixed(digits)}` : '';
+      // Fields travel as float32 without rounding: a range of 1e-12 kPa (an equilibrated design's
+      // residual) is shown as such, not as 0.0000 .. 0.0000.
+      const span = hi - lo;
+      const digits = Math.min(8, Math.max(3, Math.ceil(Math.log10(Math.max(Math.abs(lo), Math.abs(hi)) / span)) + 2));
+      const label = (v) => (uniform || span >= 0.1 ? v.toFixed(2) : v.toPrecision(digits));
+      legend.querySelector('.lo').textContent = shown ? label(lo) : '';
+      legend.querySelector('.hi').textContent = shown ? label(uniform ? lo : hi) : '';
     } else {
       legend.hidden = true;
     }
