@@ -1,6 +1,7 @@
 #include "studio/studio_compute.hpp"
 
 #include <chrono>
+#include <future>
 #include <cmath>
 #include <fmt/format.h>
 #include <random>
@@ -225,7 +226,13 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
     incisions_only.incisions = requests.incisions;
     plan_ = plan_cuts(*body_surface_, incisions_only);
   }
-  preview_statics_.reset();  // it refers to the model being replaced
+  // The statics refer to the model being replaced; a factorization still running keeps its own
+  // reference to it and is dropped when done.
+  preview_statics_.reset();
+  preview_multigrid_.reset();
+  factor_failed_.clear();
+  if (pending_statics_.valid()) abandoned_statics_.push_back(std::move(pending_statics_));
+  std::erase_if(abandoned_statics_, [](const auto& f) { return f.wait_for(std::chrono::seconds(0)) == std::future_status::ready; });
   preview_model_ = std::make_shared<TissueModel>(session_.model());
   apply_cut_plan(preview_model_->volume, plan_);
   preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
@@ -331,13 +338,41 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     }
     t = Clock::now();
     report(ctx.progress, "opening the incisions", 0.7);
-    if (!preview_statics_) {
-      StaticOptions options;
-      options.solver = SolverKind::cholmod;
-      options.fixed_vertices = held_cut_;
-      preview_statics_ = std::make_unique<StaticSolver>(*preview_model_, options);
+    StaticOptions options;
+    options.solver = SolverKind::cholmod;
+    options.fixed_vertices = held_cut_;
+    if (!preview_statics_ && pending_statics_.valid() &&
+        pending_statics_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+      try {
+        preview_statics_ = pending_statics_.get();
+        preview_multigrid_.reset();
+      } catch (const std::exception& e) {
+        // E.g. out of memory for the factor: this cut model stays with the multigrid.
+        factor_failed_ = e.what();
+      }
     }
-    const StaticResult r = preview_statics_->solve(stress_kPa_);
+    if (!factor_failed_.empty()) message["statics_note"] = "the direct factorization failed (" + factor_failed_ + "); solved by the multigrid";
+    StaticSolver* statics = preview_statics_.get();
+    if (!statics) {
+      if (!preview_multigrid_) {
+        StaticOptions multigrid = options;
+        multigrid.solver = SolverKind::multigrid_cg;
+        preview_multigrid_ = std::make_unique<StaticSolver>(*preview_model_, multigrid);
+      }
+      statics = preview_multigrid_.get();
+    }
+    const StaticResult r = statics->solve(stress_kPa_);
+    message["statics_solver"] = r.solver_name;
+    if (!preview_statics_ && !pending_statics_.valid() && factor_failed_.empty()) {
+      // The lazy caches of the volume are filled here, so that the factorization's thread only reads.
+      preview_model_->volume.vertex_cells();
+      preview_model_->volume.component_count();
+      pending_statics_ = std::async(std::launch::async, [model = preview_model_, options] {
+        auto solver = std::make_unique<StaticSolver>(*model, options);
+        solver->set_up_solver();
+        return solver;
+      });
+    }
     displacement_mm_ = r.displacement_mm;
     timings["incisions"] = ms_since(t);
   }

@@ -2,6 +2,8 @@
 // studio's incision preview after a design edit). Each solve must equal a fresh solve_static.
 #include <gtest/gtest.h>
 
+#include <thread>
+
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/static_solver.hpp"
 #include "cleave/grid/linked_volume.hpp"
@@ -56,6 +58,25 @@ TEST(StaticSolver, RepeatedSolvesEqualFreshSolvesOnACutBodyWithPrescribedSupport
   }
   EXPECT_TRUE(statics.set_up());
   EXPECT_EQ(statics.solves(), 3);
+}
+
+TEST(StaticSolver, SetUpOnAnotherThreadThenSolvedHereEqualsAFreshSolve) {
+  // The studio factors a new cut model on a thread of its own and solves with it on its worker.
+  const TissueModel model = test::make_box_model({6, 3, 3}, 2.0);
+  StaticOptions options;
+  options.solver = SolverKind::cholmod;
+  options.fixed_vertices = vertices_in_box(model.volume, Vec3(-0.1, -1, -1), Vec3(0.1, 7, 7));
+  StaticSolver statics(model, options);
+  std::thread([&] { statics.set_up_solver(); }).join();
+  EXPECT_TRUE(statics.set_up());
+  EXPECT_EQ(statics.solves(), 0) << "set up, not solved";
+  statics.set_up_solver();  // set up already: nothing happens
+  const std::vector<Vec6> stress = graded_stress(model.volume, 10.0);
+  const StaticResult kept = statics.solve(stress);
+  const StaticResult fresh = solve_static(model, stress, options);
+  ASSERT_GT(max_norm_mm(fresh.displacement_mm), 1e-3);
+  EXPECT_LT(max_difference_mm(kept.displacement_mm, fresh.displacement_mm), 1e-10 * max_norm_mm(fresh.displacement_mm));
+  EXPECT_EQ(statics.solves(), 1);
 }
 
 TEST(StaticSolver, NoLoadNeedsNoSolveAndMovesNothing) {

@@ -5,10 +5,12 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <mutex>
+#include <thread>
 #include <unistd.h>
 
 #include "cleave/pipeline/demo_case.hpp"
@@ -179,6 +181,44 @@ TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGet
   EXPECT_NE(results[3]["surface"]["id"], first["id"]) << "rebuilt, so named anew";
   ASSERT_TRUE(latest["surface"].contains("triangles")) << "the latest result keeps its triangles for new clients";
   EXPECT_EQ(unpacked_indices(latest["surface"]["triangles"]), triangles) << "the uncut surface again";
+}
+
+TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBothAgree) {
+  StudioSession session(fresh_folder("handoff"), bare_model_case(kCoarseAbdomen));
+  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
+  session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", demo["strokes"][0]["points"]}});
+  const json& p = demo["control_points"][0];
+  session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", 20}, {"cross_kPa", 10}});
+  std::mutex m;
+  std::vector<json> results;
+  StudioCompute compute(session, [&](std::string text) {
+    json message = json::parse(text);
+    std::lock_guard lock(m);
+    if (message["type"] == "result") results.push_back(std::move(message));
+  });
+  const auto latest = [&] {
+    compute.design_changed(session.design(), session.seq());
+    compute.wait_idle();
+    std::lock_guard lock(m);
+    return results.back();
+  };
+  const json first = latest();
+  ASSERT_EQ(first["statics_solver"], "multigrid") << "a new cut model: the multigrid answers at once";
+  ASSERT_FALSE(first["incisions"].empty());
+  // The same design again until the factor made meanwhile is taken (it is made on its own thread).
+  json again;
+  for (int attempt = 0; attempt < 200; ++attempt) {
+    again = latest();
+    if (again["statics_solver"] == "cholmod") break;
+    std::this_thread::sleep_for(std::chrono::milliseconds(50));
+  }
+  ASSERT_EQ(again["statics_solver"], "cholmod");
+  ASSERT_EQ(again["incisions"].size(), first["incisions"].size());
+  for (std::size_t i = 0; i < first["incisions"].size(); ++i) {
+    EXPECT_NEAR(again["incisions"][i]["opening_mm"].get<double>(), first["incisions"][i]["opening_mm"].get<double>(), 1e-4)
+        << "incision " << i << ": the multigrid's and the factor's statics agree";
+    EXPECT_NEAR(again["incisions"][i]["axis_ratio"].get<double>(), first["incisions"][i]["axis_ratio"].get<double>(), 1e-4);
+  }
 }
 
 }  // namespace

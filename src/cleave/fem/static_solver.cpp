@@ -28,6 +28,12 @@ StaticSolver::StaticSolver(const TissueModel& model, SparseMatrix stiffness, con
   solver_ = make_linear_solver(options.solver, options.settings);
 }
 
+void StaticSolver::set_up_solver() {
+  if (set_up_) return;
+  solver_->setup(eliminated_, model_.volume);
+  set_up_ = true;
+}
+
 StaticResult StaticSolver::solve(std::span<const Vec6> residual_stress_kPa) {
   const LinkedVolume& volume = model_.volume;
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
@@ -46,10 +52,7 @@ StaticResult StaticSolver::solve(std::span<const Vec6> residual_stress_kPa) {
   for (Eigen::Index j = 0; j < dofs; ++j)
     if (fixed_.fixed[static_cast<std::size_t>(j)] != 0) f[j] = 0.0;
   f += fixed_load_;
-  if (!set_up_) {
-    solver_->setup(eliminated_, volume);
-    set_up_ = true;
-  }
+  set_up_solver();
   Vector u = fixed_.value_mm;
   result.report = solver_->solve(f, u);
   ++solves_;

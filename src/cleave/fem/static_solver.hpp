@@ -29,6 +29,11 @@ class StaticSolver {
   /// is set up at the first loaded solve and kept. Throws as solve_static.
   StaticResult solve(std::span<const Vec6> residual_stress_kPa);
 
+  /// Sets the linear solver up now (a CHOLMOD factorization, a multigrid hierarchy) instead of at
+  /// the first loaded solve, e.g. on another thread while the caller shows something else; then
+  /// the first solve costs one solve. Does nothing when it is set up.
+  void set_up_solver();
+
   int solves() const { return solves_; }  ///< loaded solves done
   bool set_up() const { return set_up_; }
 
