@@ -1,9 +1,9 @@
 #include "studio/studio_compute.hpp"
 
 #include <chrono>
-#include <future>
 #include <cmath>
 #include <fmt/format.h>
+#include <future>
 #include <random>
 #include <tbb/parallel_for.h>
 
