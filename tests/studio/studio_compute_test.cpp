@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <fstream>
 #include <mutex>
 #include <thread>
@@ -123,16 +124,26 @@ TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
   EXPECT_GE(along, static_cast<int>(incisions.size()) * 3 / 4) << "long axes along Langer's lines";
 }
 
+/// The "result" messages a StudioCompute sends (from its worker thread).
+struct ResultLog {
+  std::mutex mutex;
+  std::vector<json> results;
+  std::function<void(std::string)> sender() {
+    return [this](std::string text) {
+      json message = json::parse(text);
+      std::lock_guard lock(mutex);
+      if (message["type"] == "result") results.push_back(std::move(message));
+    };
+  }
+};
+
 TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGetsThemAll) {
   StudioSession session(fresh_folder("lean"), bare_model_case(kCoarseAbdomen));
   const json demo = abdomen_demo_case(session.model(), DemoStress::designed);
-  std::mutex m;
-  std::vector<json> results;
-  StudioCompute compute(session, [&](std::string text) {
-    json message = json::parse(text);
-    std::lock_guard lock(m);
-    if (message["type"] == "result") results.push_back(std::move(message));
-  });
+  ResultLog log;
+  StudioCompute compute(session, log.sender());
+  std::mutex& m = log.mutex;
+  std::vector<json>& results = log.results;
   const auto edit = [&](const json& e) {
     session.apply_edit(e);
     compute.design_changed(session.design(), session.seq());
@@ -189,13 +200,10 @@ TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBo
   session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", demo["strokes"][0]["points"]}});
   const json& p = demo["control_points"][0];
   session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", 20}, {"cross_kPa", 10}});
-  std::mutex m;
-  std::vector<json> results;
-  StudioCompute compute(session, [&](std::string text) {
-    json message = json::parse(text);
-    std::lock_guard lock(m);
-    if (message["type"] == "result") results.push_back(std::move(message));
-  });
+  ResultLog log;
+  StudioCompute compute(session, log.sender());
+  std::mutex& m = log.mutex;
+  std::vector<json>& results = log.results;
   const auto latest = [&] {
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
