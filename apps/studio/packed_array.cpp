@@ -49,7 +49,7 @@ std::vector<T> unpacked(const nlohmann::json& array, const char* kind) {
   if (bytes.size() != count * sizeof(T))
     throw InputError(fmt::format("packed array: {} bytes for {} values of {} bytes", bytes.size(), count, sizeof(T)));
   out.resize(count);
-  std::memcpy(out.data(), bytes.data(), bytes.size());
+  if (!bytes.empty()) std::memcpy(out.data(), bytes.data(), bytes.size());  // an empty vector's data() may be null
   return out;
 }
 

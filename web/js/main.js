@@ -126,6 +126,8 @@ function showNotes(m) {
   if (m.eigenvalue_note) notes.push(['note', m.eigenvalue_note]);
   for (const key of ['design_error', 'cut_error']) if (m[key]) notes.push(['error', m[key]]);
   if (m.equilibrium_residual) notes.push(['note', `equilibrium residual ||T σ|| / (||T|| ||σ||) = ${m.equilibrium_residual.final.toExponential(2)}`]);
+  if (m.statics_solver === 'multigrid' && !m.statics_note) notes.push(['note', 'incisions solved by the multigrid while the direct factor of this cut body is prepared (later edits: faster)']);
+  if (m.statics_note) notes.push(['error', m.statics_note]);
   $('notes').replaceChildren(...notes.map(([cls, text]) => { const d = document.createElement('div'); d.className = cls; d.textContent = text; return d; }));
 }
 
