@@ -289,6 +289,45 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
   timings["frame"] = step_ms / kOpeningFrames;
 }
 
+StaticResult StudioCompute::solve_preview_statics(nlohmann::json& message) {
+  StaticOptions options;
+  options.solver = SolverKind::cholmod;
+  options.fixed_vertices = held_cut_;
+  if (!preview_statics_ && pending_statics_.valid() &&
+      pending_statics_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
+    try {
+      preview_statics_ = pending_statics_.get();
+      preview_multigrid_.reset();
+    } catch (const std::exception& e) {
+      // E.g. out of memory for the factor: this cut model stays with the multigrid.
+      factor_failed_ = e.what();
+    }
+  }
+  if (!factor_failed_.empty()) message["statics_note"] = "the direct factorization failed (" + factor_failed_ + "); solved by the multigrid";
+  StaticSolver* statics = preview_statics_.get();
+  if (!statics) {
+    if (!preview_multigrid_) {
+      StaticOptions multigrid = options;
+      multigrid.solver = SolverKind::multigrid_cg;
+      preview_multigrid_ = std::make_unique<StaticSolver>(*preview_model_, multigrid);
+    }
+    statics = preview_multigrid_.get();
+  }
+  StaticResult r = statics->solve(stress_kPa_);
+  message["statics_solver"] = r.solver_name;
+  if (!preview_statics_ && !pending_statics_.valid() && factor_failed_.empty()) {
+    // The lazy caches of the volume are filled here, so that the factorization's thread only reads.
+    preview_model_->volume.vertex_cells();
+    preview_model_->volume.component_count();
+    pending_statics_ = std::async(std::launch::async, [model = preview_model_, options] {
+      auto solver = std::make_unique<StaticSolver>(*model, options);
+      solver->set_up_solver();
+      return solver;
+    });
+  }
+  return r;
+}
+
 nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx) {
   const auto t0 = Clock::now();
   nlohmann::json timings = nlohmann::json::object();
@@ -338,41 +377,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     }
     t = Clock::now();
     report(ctx.progress, "opening the incisions", 0.7);
-    StaticOptions options;
-    options.solver = SolverKind::cholmod;
-    options.fixed_vertices = held_cut_;
-    if (!preview_statics_ && pending_statics_.valid() &&
-        pending_statics_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
-      try {
-        preview_statics_ = pending_statics_.get();
-        preview_multigrid_.reset();
-      } catch (const std::exception& e) {
-        // E.g. out of memory for the factor: this cut model stays with the multigrid.
-        factor_failed_ = e.what();
-      }
-    }
-    if (!factor_failed_.empty()) message["statics_note"] = "the direct factorization failed (" + factor_failed_ + "); solved by the multigrid";
-    StaticSolver* statics = preview_statics_.get();
-    if (!statics) {
-      if (!preview_multigrid_) {
-        StaticOptions multigrid = options;
-        multigrid.solver = SolverKind::multigrid_cg;
-        preview_multigrid_ = std::make_unique<StaticSolver>(*preview_model_, multigrid);
-      }
-      statics = preview_multigrid_.get();
-    }
-    const StaticResult r = statics->solve(stress_kPa_);
-    message["statics_solver"] = r.solver_name;
-    if (!preview_statics_ && !pending_statics_.valid() && factor_failed_.empty()) {
-      // The lazy caches of the volume are filled here, so that the factorization's thread only reads.
-      preview_model_->volume.vertex_cells();
-      preview_model_->volume.component_count();
-      pending_statics_ = std::async(std::launch::async, [model = preview_model_, options] {
-        auto solver = std::make_unique<StaticSolver>(*model, options);
-        solver->set_up_solver();
-        return solver;
-      });
-    }
+    const StaticResult r = solve_preview_statics(message);
     displacement_mm_ = r.displacement_mm;
     timings["incisions"] = ms_since(t);
   }

@@ -52,6 +52,9 @@ class StudioCompute {
   /// Stage 2: the model cut by `requests`; reuses the previous cut model when `key` is unchanged.
   /// Returns true when the cut model was rebuilt.
   bool cut_model(const CutRequests& requests, const std::string& key, nlohmann::json& message);
+  /// The statics of preview_model_ under stress_kPa_: with the kept factor once it is ready, with
+  /// the kept multigrid until then (the factorization is started here, on a thread of its own).
+  StaticResult solve_preview_statics(nlohmann::json& message);
   /// The wound opening over time (Newmark dynamics on the cut model), one "frame" message per step.
   void stream_opening(const DesignState& design, std::uint64_t generation, const FieldWorker::Context& ctx,
                       nlohmann::json& timings);
