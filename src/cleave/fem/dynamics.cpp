@@ -50,11 +50,14 @@ std::string_view Dynamics::solver_name() const { return solver_->name(); }
 void Dynamics::rebuild_topology() {
   mass_ = lumped_mass(model_, table_);
   system_ = make_vertex_block_pattern(model_.volume);
-  diagonal_.assign(static_cast<std::size_t>(system_.rows()), 0);
-  for (Eigen::Index row = 0; row < system_.rows(); ++row) {
-    const auto* begin = system_.innerIndexPtr() + system_.outerIndexPtr()[row];
-    const auto* end = system_.innerIndexPtr() + system_.outerIndexPtr()[row + 1];
-    diagonal_[static_cast<std::size_t>(row)] = std::lower_bound(begin, end, row) - system_.innerIndexPtr();
+  system_blocks_ = to_block_sparse<double>(system_);
+  gather_ = make_vertex_block_gather(model_.volume, system_blocks_);
+  diagonal_block_.assign(static_cast<std::size_t>(system_blocks_.block_rows()), 0);
+  for (Eigen::Index v = 0; v < system_blocks_.block_rows(); ++v) {
+    const auto begin = system_blocks_.column.begin() + system_blocks_.row_start[static_cast<std::size_t>(v)];
+    const auto end = system_blocks_.column.begin() + system_blocks_.row_start[static_cast<std::size_t>(v) + 1];
+    diagonal_block_[static_cast<std::size_t>(v)] =
+        static_cast<std::int32_t>(std::lower_bound(begin, end, static_cast<std::int32_t>(v)) - system_blocks_.column.begin());
   }
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
   update_rotations();
@@ -176,16 +179,41 @@ void Dynamics::assemble_system(double c_stiff, double c_mass) {
     const Mat3& r = rotations_[static_cast<std::size_t>(c)];
     return (c_stiff * r) * table_.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
   };
-  double* values = system_.valuePtr();
+  double* values = system_blocks_.values.data();
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, volume.vertex_count()), [&](const tbb::blocked_range<VertexId>& r) {
     for (VertexId v = r.begin(); v != r.end(); ++v) {
-      gather_vertex_rows(volume, v, block, system_);
-      for (int i = 0; i < 3; ++i) {
-        const auto dof = static_cast<std::size_t>(3 * v + i);
-        values[diagonal_[dof]] += c_mass * mass_[static_cast<Eigen::Index>(dof)];
-      }
+      gather_vertex_block_row(volume, v, gather_, block, system_blocks_);
+      double* diagonal = values + 9 * static_cast<std::size_t>(diagonal_block_[static_cast<std::size_t>(v)]);
+      for (int i = 0; i < 3; ++i) diagonal[4 * i] += c_mass * mass_[3 * static_cast<Eigen::Index>(v) + i];
     }
   });
+}
+
+void Dynamics::hand_system_to_solver() {
+  // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
+  // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
+  // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
+  // LinearSolver::update_topology) unless a divided vertex's origin is unknown.
+  const VertexId vertices = model_.volume.vertex_count();
+  const bool origins_known = std::none_of(origin_of_new_.begin(), origin_of_new_.end(),
+                                          [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
+                             static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
+  const bool keep = solver_ready_ && solver_mass_factor_ == current_mass_factor_ && origins_known;
+  const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
+  if (!taken_as_blocks) {
+    copy_block_values(system_blocks_, system_);
+    if (keep && origin_of_new_.empty()) {
+      solver_->update_values(system_, model_.volume);
+    } else if (keep) {
+      solver_->update_topology(system_, model_.volume, origin_of_new_);
+    } else {
+      solver_->setup(system_, model_.volume);
+      solver_ready_ = true;
+      solver_mass_factor_ = current_mass_factor_;
+    }
+  }
+  solver_vertices_ = vertices;
+  origin_of_new_.clear();
 }
 
 void Dynamics::compute_acceleration() {
@@ -239,7 +267,7 @@ SolveReport Dynamics::step(double dt) {
     FixedDofs held;
     held.fixed = fixed_;
     held.value_mm = Vector::Zero(u_.size());
-    eliminate_fixed_dofs(system_, rhs, held);
+    eliminate_fixed_dofs(system_blocks_, rhs, held);
   }
 
   Vector du = dt * v_ + 0.5 * dt * dt * a_;  // Newmark predictor: warm start
@@ -250,24 +278,8 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
-    // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
-    // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
-    // LinearSolver::update_topology) unless a divided vertex's origin is unknown.
-    const VertexId vertices = model_.volume.vertex_count();
-    const bool origins_known = std::none_of(origin_of_new_.begin(), origin_of_new_.end(),
-                                            [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
-                               static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
-    if (solver_ready_ && c_mass == solver_mass_factor_ && origins_known) {
-      if (origin_of_new_.empty()) solver_->update_values(system_, model_.volume);
-      else solver_->update_topology(system_, model_.volume, origin_of_new_);
-    } else {
-      solver_->setup(system_, model_.volume);
-      solver_ready_ = true;
-      solver_mass_factor_ = c_mass;
-    }
-    solver_vertices_ = vertices;
-    origin_of_new_.clear();
+    current_mass_factor_ = c_mass;
+    hand_system_to_solver();
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

@@ -35,6 +35,8 @@
 
 #include "cleave/fem/element_table.hpp"
 #include "cleave/model/tissue_model.hpp"
+#include "cleave/fem/vertex_block_matrix.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/linear_solver.hpp"
 
 namespace cleave {
@@ -103,8 +105,10 @@ class Dynamics {
   /// damping force of `velocity` from the same per-cell pass (K_R is never assembled for it).
   Vector internal_forces(const Vector* velocity = nullptr) const;
   Vector external_forces() const;
-  /// system_ = c_stiff K_R + c_mass M in one gather (no separate K_R, no scaling pass).
+  /// system_blocks_ = c_stiff K_R + c_mass M in one gather (no separate K_R, no scaling pass).
   void assemble_system(double c_stiff, double c_mass);
+  /// Gives the solver the assembled system: block values where it takes them, else system_.
+  void hand_system_to_solver();
   void compute_acceleration();
 
   const TissueModel& model_;
@@ -115,8 +119,14 @@ class Dynamics {
 
   Vector mass_;    ///< lumped, per dof (kg)
   std::vector<std::uint8_t> fixed_;
-  SparseMatrix system_;     ///< c_k K_R + c_m M with fixed dofs eliminated; vertex block pattern of the topology
-  std::vector<Eigen::Index> diagonal_;  ///< per dof: position of its diagonal entry in the value arrays
+  /// c_k K_R + c_m M with fixed dofs eliminated, as block CSR: assembled every step (what the
+  /// multigrid multiplies with: LinearSolver::update_block_values).
+  BlockSparseMatrix<double> system_blocks_;
+  VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
+  std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_
+  /// The same matrix as scalar CSR (vertex block pattern of the topology), filled from the blocks
+  /// only when a solver asks for it (setup, a cut, CHOLMOD).
+  SparseMatrix system_;
   bool any_fixed_ = false;
   bool solver_ready_ = false;  ///< set up (later steps update values, or the topology after a cut)
   VertexId solver_vertices_ = 0;  ///< vertex count of the topology the solver last saw
@@ -124,6 +134,7 @@ class Dynamics {
   /// from, as the solver knew it (kNone: unknown, the solver is set up afresh).
   std::vector<VertexId> origin_of_new_;
   double solver_mass_factor_ = 0;  ///< c_m of the matrix the solver was set up with (1/s^2)
+  double current_mass_factor_ = 0;  ///< c_m of the system assembled for this step
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;
   double time_s_ = 0;

@@ -64,4 +64,46 @@ void eliminate_fixed_dofs(SparseMatrix& a, Vector& b, const FixedDofs& fixed) {
   }
 }
 
+void eliminate_fixed_dofs(BlockSparseMatrix<double>& a, Vector& b, const FixedDofs& fixed) {
+  const auto is_fixed = [&](Eigen::Index dof) { return fixed.fixed[static_cast<std::size_t>(dof)] != 0; };
+  const auto block_of = [&](Eigen::Index row, Eigen::Index column) -> double* {
+    const auto first = a.column.begin() + a.row_start[static_cast<std::size_t>(row)];
+    const auto last = a.column.begin() + a.row_start[static_cast<std::size_t>(row) + 1];
+    const auto found = std::lower_bound(first, last, static_cast<std::int32_t>(column));
+    if (found == last || *found != column) return nullptr;  // structurally zero
+    return a.values.data() + 9 * static_cast<std::size_t>(found - a.column.begin());
+  };
+  for (Eigen::Index v = 0; v < a.block_rows(); ++v) {
+    if (!is_fixed(3 * v) && !is_fixed(3 * v + 1) && !is_fixed(3 * v + 2)) continue;
+    // Column side first (entry (i, j), j fixed, i free, found in block row w through the
+    // symmetric pattern), then the fixed rows themselves.
+    for (auto k = a.row_start[static_cast<std::size_t>(v)]; k < a.row_start[static_cast<std::size_t>(v) + 1]; ++k) {
+      const Eigen::Index w = a.column[static_cast<std::size_t>(k)];
+      double* mirror = block_of(w, v);
+      if (mirror == nullptr) continue;
+      for (int jj = 0; jj < 3; ++jj) {
+        const Eigen::Index j = 3 * v + jj;
+        if (!is_fixed(j)) continue;
+        for (int ii = 0; ii < 3; ++ii) {
+          const Eigen::Index i = 3 * w + ii;
+          if (i == j || is_fixed(i)) continue;
+          double& entry = mirror[3 * ii + jj];
+          b[i] -= entry * fixed.value_mm[j];
+          entry = 0.0;
+        }
+      }
+    }
+    for (auto k = a.row_start[static_cast<std::size_t>(v)]; k < a.row_start[static_cast<std::size_t>(v) + 1]; ++k) {
+      const Eigen::Index w = a.column[static_cast<std::size_t>(k)];
+      double* block = a.values.data() + 9 * static_cast<std::size_t>(k);
+      for (int ii = 0; ii < 3; ++ii) {
+        if (!is_fixed(3 * v + ii)) continue;
+        for (int jj = 0; jj < 3; ++jj) block[3 * ii + jj] = (w == v && ii == jj) ? 1.0 : 0.0;
+      }
+    }
+    for (int ii = 0; ii < 3; ++ii)
+      if (is_fixed(3 * v + ii)) b[3 * v + ii] = fixed.value_mm[3 * v + ii];
+  }
+}
+
 }  // namespace cleave

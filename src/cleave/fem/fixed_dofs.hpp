@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "cleave/core/types.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/linear_solver.hpp"
 
 namespace cleave {
@@ -32,5 +33,8 @@ std::vector<VertexId> vertices_in_box(const LinkedVolume& volume, const Vec3& lo
 /// A must be compressed with a structurally symmetric pattern (as every vertex-block matrix is);
 /// the work is proportional to the entries of the fixed rows.
 void eliminate_fixed_dofs(SparseMatrix& a, Vector& b, const FixedDofs& fixed);
+/// The same on a block CSR matrix (3x3 vertex blocks, structurally symmetric block pattern with
+/// every diagonal block present): equal, entry by entry, to the CSR elimination of the same matrix.
+void eliminate_fixed_dofs(BlockSparseMatrix<double>& a, Vector& b, const FixedDofs& fixed);
 
 }  // namespace cleave

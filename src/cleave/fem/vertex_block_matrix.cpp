@@ -2,6 +2,9 @@
 
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
+#include <fmt/format.h>
+
+#include "cleave/core/error.hpp"
 
 namespace cleave {
 
@@ -90,6 +93,36 @@ std::vector<std::uint8_t> vertices_affected_by_cut(const LinkedVolume& volume, c
     for (const VertexId v : split.created) affected[static_cast<std::size_t>(v)] = 1;
   }
   return affected;
+}
+
+VertexBlockGather make_vertex_block_gather(const LinkedVolume& volume, const BlockSparseMatrix<double>& matrix) {
+  const auto& vertex_cells = volume.vertex_cells();
+  VertexBlockGather g;
+  g.first_slot.assign(vertex_cells.size() + 1, 0);
+  for (std::size_t v = 0; v < vertex_cells.size(); ++v)
+    g.first_slot[v + 1] = g.first_slot[v] + static_cast<std::int64_t>(vertex_cells[v].size());
+  const auto slots = static_cast<std::size_t>(g.first_slot.back());
+  g.corner.resize(slots);
+  g.block.resize(8 * slots);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertex_cells.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v != r.end(); ++v) {
+      const auto first = matrix.column.begin() + matrix.row_start[v];
+      const auto last = matrix.column.begin() + matrix.row_start[v + 1];
+      for (std::size_t t = 0; t < vertex_cells[v].size(); ++t) {
+        const auto slot = static_cast<std::size_t>(g.first_slot[v]) + t;
+        const auto& corners = volume.cell_vertices(vertex_cells[v][t]);
+        for (int b = 0; b < kCornerCount; ++b) {
+          const VertexId w = corners[static_cast<std::size_t>(b)];
+          if (w == static_cast<VertexId>(v)) g.corner[slot] = static_cast<std::uint8_t>(b);
+          const auto found = std::lower_bound(first, last, static_cast<std::int32_t>(w));
+          if (found == last || *found != w)
+            throw InputError(fmt::format("vertex block gather: vertex {} shares a cell with {}, but the matrix has no block ({}, {})", v, w, v, w));
+          g.block[8 * slot + static_cast<std::size_t>(b)] = static_cast<std::int32_t>(found - matrix.column.begin());
+        }
+      }
+    }
+  });
+  return g;
 }
 
 }  // namespace cleave

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "cleave/grid/linked_volume.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/linear_solver.hpp"
 
 namespace cleave {
@@ -58,6 +59,40 @@ void gather_vertex_rows(const LinkedVolume& volume, VertexId v, const BlockFn& b
       const Mat3 m = block(c, a, b);
       for (int i = 0; i < 3; ++i)
         for (int j = 0; j < 3; ++j) values[start[i] + offset + j] += m(i, j);
+    }
+  }
+}
+
+/// Where the gather into block CSR writes: for vertex v and the t-th cell around it
+/// (volume.vertex_cells()[v][t]), v's corner in that cell and, per corner b of the cell, the
+/// block of row v at column corner_vertex(b). Made once per topology, it spares every assembly
+/// the search of those blocks in the row.
+struct VertexBlockGather {
+  std::vector<std::int64_t> first_slot;  ///< per vertex and one past the last: first (v, t) slot
+  std::vector<std::uint8_t> corner;      ///< per slot: v's corner (0..7) in the cell
+  std::vector<std::int32_t> block;       ///< per slot, 8 each: the block index for corner b
+};
+
+/// The gather table of `matrix` (block CSR with the block pattern of the volume's current topology).
+VertexBlockGather make_vertex_block_gather(const LinkedVolume& volume, const BlockSparseMatrix<double>& matrix);
+
+/// The same as gather_vertex_rows into block CSR: overwrites block row v of `matrix` (the matrix
+/// `gather` was made for) with the sum over the cells c around v and corners b of block(c, a, b).
+template <typename BlockFn>
+void gather_vertex_block_row(const LinkedVolume& volume, VertexId v, const VertexBlockGather& gather, const BlockFn& block,
+                             BlockSparseMatrix<double>& matrix) {
+  const auto row = static_cast<std::size_t>(v);
+  double* values = matrix.values.data();
+  std::fill(values + 9 * static_cast<std::size_t>(matrix.row_start[row]), values + 9 * static_cast<std::size_t>(matrix.row_start[row + 1]), 0.0);
+  const std::vector<CellId>& cells = volume.vertex_cells()[row];
+  for (std::size_t t = 0; t < cells.size(); ++t) {
+    const auto slot = static_cast<std::size_t>(gather.first_slot[row]) + t;
+    const int a = gather.corner[slot];
+    for (int b = 0; b < kCornerCount; ++b) {
+      const Mat3 m = block(cells[t], a, b);
+      double* target = values + 9 * static_cast<std::size_t>(gather.block[8 * slot + static_cast<std::size_t>(b)]);
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j) target[3 * i + j] += m(i, j);
     }
   }
 }

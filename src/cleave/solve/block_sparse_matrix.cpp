@@ -139,6 +139,22 @@ void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a) {
   for_each_block_row(b.block_rows(), [&](Eigen::Index v) {
     const auto first = b.column.begin() + b.row_start[static_cast<std::size_t>(v)];
     const auto last = b.column.begin() + b.row_start[static_cast<std::size_t>(v) + 1];
+    const auto blocks = static_cast<std::size_t>(last - first);
+    const auto same_blocks = [&] {
+      if (!is_vertex_block_row(a, v) || static_cast<std::size_t>(outer[3 * v + 1] - outer[3 * v]) != 3 * blocks) return false;
+      for (std::size_t j = 0; j < blocks; ++j)
+        if (first[static_cast<std::ptrdiff_t>(j)] != inner[outer[3 * v] + static_cast<Eigen::Index>(3 * j)] / 3) return false;
+      return true;
+    };
+    if (same_blocks()) {
+      // The CSR row's triples are b's blocks in order: a straight copy.
+      for (int i = 0; i < 3; ++i) {
+        const double* source = b.values.data() + 9 * static_cast<std::size_t>(first - b.column.begin()) + 3 * static_cast<std::size_t>(i);
+        double* target = values + outer[3 * v + i];
+        for (std::size_t j = 0; j < blocks; ++j, source += 9, target += 3) std::copy_n(source, 3, target);
+      }
+      return;
+    }
     for (int i = 0; i < 3; ++i)
       for (auto k = outer[3 * v + i]; k < outer[3 * v + i + 1]; ++k) {
         const auto block = std::lower_bound(first, last, static_cast<std::int32_t>(inner[k] / 3));

@@ -14,6 +14,8 @@ namespace cleave {
 
 using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Vector = Eigen::VectorXd;
+template <typename Scalar>
+struct BlockSparseMatrix;  // block_sparse_matrix.hpp
 
 enum class SolverKind {
   multigrid_cg,  ///< cleave's default: CG preconditioned by a cut-aware geometric multigrid V-cycle
@@ -65,6 +67,16 @@ class LinearSolver {
   virtual void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) {
     (void)origin_of_new;
     setup(a, topology);
+  }
+  /// Like update_values() with the new values given as block CSR (3x3 vertex blocks) of the
+  /// pattern of the last setup, for solvers that multiply with block CSR anyway (the multigrid):
+  /// no scalar CSR needs to exist for them. Returns false, and takes nothing, when the solver
+  /// needs the scalar matrix for this update (a rebuild is due, or it works on scalar CSR): the
+  /// caller then calls update_values() with it.
+  virtual bool update_block_values(const BlockSparseMatrix<double>& a, const LinkedVolume& topology) {
+    (void)a;
+    (void)topology;
+    return false;
   }
   /// Solves A x = b; x holds the initial guess on entry (warm start) and the solution on exit.
   /// Never leaves NaN in x: on divergence x keeps its last finite iterate and converged = false.

@@ -48,6 +48,17 @@ class MultigridCgSolver final : public LinearSolver {
     topology_ = &topology;
   }
 
+  bool update_block_values(const BlockSparseMatrix<double>& a, const LinkedVolume& topology) override {
+    if (rebuild_requested_ || stale_updates_ >= options_.max_stale_updates || a.row_start != a_blocks_.row_start ||
+        a.column != a_blocks_.column)
+      return false;
+    a_blocks_.values = a.values;
+    preconditioner_.refresh_fine_level(a_blocks_);
+    ++stale_updates_;
+    topology_ = &topology;
+    return true;
+  }
+
   void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) override {
     const Eigen::Index expected_rows = a_.rows() + 3 * static_cast<Eigen::Index>(origin_of_new.size());
     if (preconditioner_.levels().size() < 2 || a.rows() != expected_rows || !a.isCompressed() || rebuild_requested_ ||
