@@ -3,6 +3,8 @@
 // rigid rotations.
 #include <gtest/gtest.h>
 
+#include <random>
+
 #include <Eigen/Geometry>
 
 #include "cleave/fem/corotation.hpp"
@@ -221,6 +223,38 @@ TEST(Dynamics, PolarDecompositionRecoversTheRotation) {
   Mat3 inverted = Mat3::Identity();
   inverted(2, 2) = -0.1;
   EXPECT_NEAR(rotation_from_deformation_gradient(inverted).determinant(), 1.0, 1e-12);
+}
+
+// The Newton iteration of the polar factor gives the SVD's rotation to rounding: random rotations
+// times symmetric stretches from tissue strains to 1:100, a nearly flat cell, and inverted ones
+// (which go to the SVD and keep its flipped axis). Its result is orthogonal with det +1.
+TEST(Dynamics, PolarRotationByNewtonEqualsTheSvdOne) {
+  std::mt19937 random(7);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  const auto random_rotation = [&] {
+    return Mat3(Eigen::AngleAxisd(3.0 * unit(random), Vec3(unit(random), unit(random), unit(random)).normalized()));
+  };
+  double worst = 0;
+  for (int i = 0; i < 300; ++i) {
+    const Mat3 q = random_rotation();
+    const double spread = i < 100 ? 0.3 : (i < 200 ? 3.0 : 100.0);  // largest / smallest principal stretch
+    const Vec3 stretches(1.0, 1.0 + (spread - 1.0) * (0.5 + 0.5 * unit(random)), spread);
+    const Mat3 s = q * stretches.asDiagonal() * q.transpose();  // symmetric positive definite
+    const Mat3 f = random_rotation() * (i < 100 ? Mat3(Mat3::Identity() + 0.3 * unit(random) * s) : s);
+    const Mat3 newton = rotation_from_deformation_gradient(f);
+    worst = std::max(worst, (newton - rotation_by_svd(f)).cwiseAbs().maxCoeff());
+    EXPECT_LT((newton * newton.transpose() - Mat3::Identity()).cwiseAbs().maxCoeff(), 1e-13);
+    EXPECT_NEAR(newton.determinant(), 1.0, 1e-13);
+  }
+  EXPECT_LT(worst, 1e-12);
+  Mat3 flat = Mat3::Identity();
+  flat(1, 1) = 1e-9;
+  EXPECT_LT((rotation_from_deformation_gradient(flat) - rotation_by_svd(flat)).cwiseAbs().maxCoeff(), 1e-12);
+  for (const double squash : {-0.1, -2.0}) {
+    Mat3 inverted = random_rotation();
+    inverted.col(1) *= squash;
+    EXPECT_EQ(rotation_from_deformation_gradient(inverted), rotation_by_svd(inverted));
+  }
 }
 
 }  // namespace
