@@ -5,6 +5,9 @@
 
 #include <algorithm>
 #include <cstddef>
+#if defined(__AVX2__) && defined(__FMA__)
+#include <immintrin.h>
+#endif
 
 namespace cleave {
 namespace {
@@ -167,9 +170,9 @@ void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a) {
 
 namespace {
 
-/// sum over the blocks of row v of A_vw x_w.
+/// sum over the blocks of row v of A_vw x_w (any scalar; the reference for the vector kernels).
 template <typename Scalar>
-inline Eigen::Matrix<Scalar, 3, 1> row_product(const BlockSparseMatrix<Scalar>& a, const Scalar* x, Eigen::Index v) {
+inline Eigen::Matrix<Scalar, 3, 1> row_product_scalar(const BlockSparseMatrix<Scalar>& a, const Scalar* x, Eigen::Index v) {
   Scalar s0 = 0, s1 = 0, s2 = 0;
   const std::int32_t last = a.row_start[static_cast<std::size_t>(v) + 1];
   const Scalar* m = a.values.data() + 9 * static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v)]);
@@ -183,6 +186,64 @@ inline Eigen::Matrix<Scalar, 3, 1> row_product(const BlockSparseMatrix<Scalar>& 
   return {s0, s1, s2};
 }
 
+#if defined(__AVX2__) && defined(__FMA__)
+// AVX2 kernels: a block's first eight values (rows 0, 1 and two thirds of row 2, row-major) in
+// one vector times x_w laid out to match, the ninth value scalar; the row sums are taken once
+// per block row. Float: 1.4-1.8x the scalar loop on the 44k tube's fine matrix, double 1.1-1.3x.
+
+inline Eigen::Matrix<float, 3, 1> row_product_avx2(const BlockSparseMatrix<float>& a, const float* x, Eigen::Index v,
+                                                   std::size_t x_size) {
+  const __m256i layout = _mm256_setr_epi32(0, 1, 2, 0, 1, 2, 0, 1);  // x0 x1 x2 x0 x1 x2 x0 x1
+  __m256 sum = _mm256_setzero_ps();
+  float s2 = 0;
+  const std::int32_t first = a.row_start[static_cast<std::size_t>(v)];
+  const std::int32_t last = a.row_start[static_cast<std::size_t>(v) + 1];
+  const float* m = a.values.data() + 9 * static_cast<std::size_t>(first);
+  for (std::int32_t k = first; k < last; ++k, m += 9) {
+    const std::size_t w3 = 3 * static_cast<std::size_t>(a.column[static_cast<std::size_t>(k)]);
+    // Four floats from x_w on (the fourth unused); the last vertex's would read past the end.
+    const __m128 xw = w3 + 4 <= x_size ? _mm_loadu_ps(x + w3) : _mm_setr_ps(x[w3], x[w3 + 1], x[w3 + 2], 0.0f);
+    sum = _mm256_fmadd_ps(_mm256_loadu_ps(m), _mm256_permutevar8x32_ps(_mm256_castps128_ps256(xw), layout), sum);
+    s2 += m[8] * x[w3 + 2];
+  }
+  alignas(32) float t[8];
+  _mm256_store_ps(t, sum);
+  return {t[0] + t[1] + t[2], t[3] + t[4] + t[5], t[6] + t[7] + s2};
+}
+
+inline Eigen::Matrix<double, 3, 1> row_product_avx2(const BlockSparseMatrix<double>& a, const double* x, Eigen::Index v,
+                                                    std::size_t /*x_size*/) {
+  __m256d sum0 = _mm256_setzero_pd(), sum1 = _mm256_setzero_pd();
+  double s2 = 0;
+  const std::int32_t first = a.row_start[static_cast<std::size_t>(v)];
+  const std::int32_t last = a.row_start[static_cast<std::size_t>(v) + 1];
+  const double* m = a.values.data() + 9 * static_cast<std::size_t>(first);
+  for (std::int32_t k = first; k < last; ++k, m += 9) {
+    const double* xw = x + 3 * static_cast<std::size_t>(a.column[static_cast<std::size_t>(k)]);
+    const double x0 = xw[0], x1 = xw[1], x2 = xw[2];
+    sum0 = _mm256_fmadd_pd(_mm256_loadu_pd(m), _mm256_setr_pd(x0, x1, x2, x0), sum0);      // m0 m1 m2 | m3
+    sum1 = _mm256_fmadd_pd(_mm256_loadu_pd(m + 4), _mm256_setr_pd(x1, x2, x0, x1), sum1);  // m4 m5 | m6 m7
+    s2 += m[8] * x2;
+  }
+  alignas(32) double t0[4], t1[4];
+  _mm256_store_pd(t0, sum0);
+  _mm256_store_pd(t1, sum1);
+  return {t0[0] + t0[1] + t0[2], t0[3] + t1[0] + t1[1], t1[2] + t1[3] + s2};
+}
+#endif
+
+/// sum over the blocks of row v of A_vw x_w; x has x_size entries.
+template <typename Scalar>
+inline Eigen::Matrix<Scalar, 3, 1> row_product(const BlockSparseMatrix<Scalar>& a, const Scalar* x, Eigen::Index v,
+                                               std::size_t x_size) {
+#if defined(__AVX2__) && defined(__FMA__)
+  return row_product_avx2(a, x, v, x_size);
+#else
+  (void)x_size;
+  return row_product_scalar(a, x, v);
+#endif
+}
+
 }  // namespace
 
 template <typename Scalar>
@@ -192,7 +253,7 @@ void multiply(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatr
   const Scalar* xp = x.data();
   Scalar* yp = y.data();
   for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
-    const auto s = row_product(a, xp, v);
+    const auto s = row_product(a, xp, v, static_cast<std::size_t>(x.size()));
     yp[3 * v] = s[0];
     yp[3 * v + 1] = s[1];
     yp[3 * v + 2] = s[2];
@@ -207,7 +268,7 @@ void residual(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatr
   const Scalar* bp = b.data();
   Scalar* rp = r.data();
   for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
-    const auto s = row_product(a, xp, v);
+    const auto s = row_product(a, xp, v, static_cast<std::size_t>(x.size()));
     rp[3 * v] = bp[3 * v] - s[0];
     rp[3 * v + 1] = bp[3 * v + 1] - s[1];
     rp[3 * v + 2] = bp[3 * v + 2] - s[2];
@@ -221,7 +282,7 @@ void jacobi_residual(const BlockSparseMatrix<Scalar>& a, const std::vector<Eigen
   z.resize(a.rows());
   const Scalar* xp = x.data();
   for_each_block_row(a.block_rows(), [&](Eigen::Index v) {
-    const Eigen::Matrix<Scalar, 3, 1> r = b.template segment<3>(3 * v) - row_product(a, xp, v);
+    const Eigen::Matrix<Scalar, 3, 1> r = b.template segment<3>(3 * v) - row_product(a, xp, v, static_cast<std::size_t>(x.size()));
     z.template segment<3>(3 * v) = inverse_diagonal[static_cast<std::size_t>(v)] * r;
   });
 }
