@@ -47,9 +47,12 @@ Dynamics::~Dynamics() = default;
 
 std::string_view Dynamics::solver_name() const { return solver_->name(); }
 
-void Dynamics::rebuild_topology() {
+void Dynamics::rebuild_topology(const CutReport* cut) {
   mass_ = lumped_mass(model_, table_);
-  system_ = make_vertex_block_pattern(model_.volume);
+  // After a cut only the rows of the vertices it touched are patterned afresh.
+  system_ = cut != nullptr && system_.rows() > 0
+                ? rebuild_vertex_block_pattern(model_.volume, system_, vertices_affected_by_cut(model_.volume, *cut))
+                : make_vertex_block_pattern(model_.volume);
   system_blocks_ = to_block_sparse<double>(system_);
   gather_ = make_vertex_block_gather(model_.volume, system_blocks_);
   diagonal_block_.assign(static_cast<std::size_t>(system_blocks_.block_rows()), 0);
@@ -90,7 +93,7 @@ void Dynamics::topology_changed(const CutReport& report) {
       for (int i = 0; i < 3; ++i)
         fixed_[static_cast<std::size_t>(3 * v + i)] = fixed_[static_cast<std::size_t>(3 * split.original + i)];
     }
-  rebuild_topology();
+  rebuild_topology(&report);
   // Positions and velocities are continuous across a cut, forces are not: the cut faces lose
   // their tractions at once. Newmark needs the acceleration that satisfies the equation of
   // motion of the new topology; the old one (copied onto split vertices) would inject momentum
@@ -205,7 +208,7 @@ void Dynamics::hand_system_to_solver() {
     if (keep && origin_of_new_.empty()) {
       solver_->update_values(system_, model_.volume);
     } else if (keep) {
-      solver_->update_topology(system_, model_.volume, origin_of_new_);
+      solver_->update_topology_with_blocks(system_, system_blocks_, model_.volume, origin_of_new_);
     } else {
       solver_->setup(system_, model_.volume);
       solver_ready_ = true;

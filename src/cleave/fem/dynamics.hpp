@@ -97,7 +97,9 @@ class Dynamics {
   double elastic_energy_uJ() const;
 
  private:
-  void rebuild_topology();
+  /// Mass, system pattern and gather table of the current topology; `cut`: the cut since the
+  /// last call (its untouched rows keep their pattern), null for a fresh one.
+  void rebuild_topology(const CutReport* cut = nullptr);
   /// Records, for every vertex the cut created, the vertex the solver knew it as (origin_of_new_).
   void note_vertex_origins(const CutReport& report);
   void update_rotations();

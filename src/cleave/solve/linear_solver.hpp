@@ -78,6 +78,14 @@ class LinearSolver {
     (void)topology;
     return false;
   }
+  /// update_topology() with the new matrix also given as block CSR (the same values, its block
+  /// pattern): the multigrid then takes the blocks instead of converting `a`. The default ignores
+  /// them.
+  virtual void update_topology_with_blocks(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
+                                           const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) {
+    (void)blocks;
+    update_topology(a, topology, origin_of_new);
+  }
   /// Solves A x = b; x holds the initial guess on entry (warm start) and the solution on exit.
   /// Never leaves NaN in x: on divergence x keeps its last finite iterate and converged = false.
   virtual SolveReport solve(const Vector& b, Vector& x) = 0;

@@ -60,17 +60,14 @@ class MultigridCgSolver final : public LinearSolver {
   }
 
   void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) override {
-    const Eigen::Index expected_rows = a_.rows() + 3 * static_cast<Eigen::Index>(origin_of_new.size());
-    if (preconditioner_.levels().size() < 2 || a.rows() != expected_rows || !a.isCompressed() || rebuild_requested_ ||
-        stale_updates_ >= options_.max_stale_updates) {
-      setup(a, topology);
-      return;
-    }
-    a_ = a;
-    a_blocks_ = to_block_sparse<double>(a_);
-    preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
-    ++stale_updates_;
-    topology_ = &topology;
+    replace_fine_level(a, nullptr, topology, origin_of_new);
+  }
+
+  void update_topology_with_blocks(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology,
+                                   const std::vector<VertexId>& origin_of_new) override {
+    if (blocks.rows() != a.rows())
+      throw InputError(fmt::format("multigrid: the block copy of the new matrix has {} rows; the matrix has {}", blocks.rows(), a.rows()));
+    replace_fine_level(a, &blocks, topology, origin_of_new);
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
@@ -105,6 +102,23 @@ class MultigridCgSolver final : public LinearSolver {
     stale_updates_ = 0;
     baseline_iterations_ = -1;
     rebuild_requested_ = false;
+  }
+
+  /// After cuts divided vertices: keeps the coarse levels and replaces the fine one (or sets up
+  /// when the levels cannot be kept). `blocks`: a's block copy when the caller has one.
+  void replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>* blocks, const LinkedVolume& topology,
+                          const std::vector<VertexId>& origin_of_new) {
+    const Eigen::Index expected_rows = a_.rows() + 3 * static_cast<Eigen::Index>(origin_of_new.size());
+    if (preconditioner_.levels().size() < 2 || a.rows() != expected_rows || !a.isCompressed() || rebuild_requested_ ||
+        stale_updates_ >= options_.max_stale_updates) {
+      setup(a, topology);
+      return;
+    }
+    a_ = a;
+    a_blocks_ = blocks != nullptr ? *blocks : to_block_sparse<double>(a_);
+    preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
+    ++stale_updates_;
+    topology_ = &topology;
   }
 
   /// `settings` to go on from where `first` left x: the initial-residual rule refers to the
