@@ -236,8 +236,17 @@ TEST(Multigrid, NewValuesAsBlocksAreTheSameUpdateAsTheScalarMatrix) {
     solver->setup(system.a, model.volume);
     Vector x = Vector::Zero(system.b.size());
     solver->solve(system.b, x);
-    if (as_blocks) EXPECT_TRUE(solver->update_block_values(to_block_sparse<double>(shifted), model.volume));
-    else solver->update_values(shifted, model.volume);
+    if (as_blocks) {
+      BlockSparseMatrix<double> blocks = to_block_sparse<double>(shifted);
+      const BlockSparseMatrix<double> given = blocks;
+      EXPECT_TRUE(solver->update_block_values(blocks, model.volume));
+      // The values were exchanged, not copied: `blocks` keeps its pattern and now holds the old matrix's.
+      EXPECT_EQ(blocks.row_start, given.row_start);
+      EXPECT_EQ(blocks.column, given.column);
+      EXPECT_EQ(blocks.values, to_block_sparse<double>(system.a).values);
+    } else {
+      solver->update_values(shifted, model.volume);
+    }
     x.setZero();
     report = solver->solve(system.b, x);
     return x;

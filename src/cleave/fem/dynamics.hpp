@@ -122,7 +122,8 @@ class Dynamics {
   Vector mass_;    ///< lumped, per dof (kg)
   std::vector<std::uint8_t> fixed_;
   /// c_k K_R + c_m M with fixed dofs eliminated, as block CSR: assembled every step (what the
-  /// multigrid multiplies with: LinearSolver::update_block_values).
+  /// multigrid multiplies with: LinearSolver::update_block_values, which exchanges its values
+  /// with the solver's older ones; every step overwrites all of them).
   BlockSparseMatrix<double> system_blocks_;
   VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
   std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_

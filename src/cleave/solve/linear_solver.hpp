@@ -70,10 +70,12 @@ class LinearSolver {
   }
   /// Like update_values() with the new values given as block CSR (3x3 vertex blocks) of the
   /// pattern of the last setup, for solvers that multiply with block CSR anyway (the multigrid):
-  /// no scalar CSR needs to exist for them. Returns false, and takes nothing, when the solver
-  /// needs the scalar matrix for this update (a rebuild is due, or it works on scalar CSR): the
-  /// caller then calls update_values() with it.
-  virtual bool update_block_values(const BlockSparseMatrix<double>& a, const LinkedVolume& topology) {
+  /// no scalar CSR needs to exist for them. The solver takes the values without copying them: it
+  /// exchanges them with its previous ones, so on return `a` keeps its pattern and holds values
+  /// of an older matrix (the caller overwrites them for the next update). Returns false, and
+  /// takes nothing, when the solver needs the scalar matrix for this update (a rebuild is due,
+  /// or it works on scalar CSR): the caller then calls update_values() with it.
+  virtual bool update_block_values(BlockSparseMatrix<double>& a, const LinkedVolume& topology) {
     (void)a;
     (void)topology;
     return false;
