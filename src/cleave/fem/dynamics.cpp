@@ -192,7 +192,7 @@ void Dynamics::assemble_system(double c_stiff, double c_mass) {
   });
 }
 
-void Dynamics::hand_system_to_solver() {
+void Dynamics::hand_system_to_solver(double c_mass) {
   // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
   // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
   // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
@@ -201,7 +201,7 @@ void Dynamics::hand_system_to_solver() {
   const bool origins_known = std::none_of(origin_of_new_.begin(), origin_of_new_.end(),
                                           [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
                              static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
-  const bool keep = solver_ready_ && solver_mass_factor_ == current_mass_factor_ && origins_known;
+  const bool keep = solver_ready_ && solver_mass_factor_ == c_mass && origins_known;
   const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
   if (!taken_as_blocks) {
     copy_block_values(system_blocks_, system_);
@@ -212,7 +212,7 @@ void Dynamics::hand_system_to_solver() {
     } else {
       solver_->setup(system_, model_.volume);
       solver_ready_ = true;
-      solver_mass_factor_ = current_mass_factor_;
+      solver_mass_factor_ = c_mass;
     }
   }
   solver_vertices_ = vertices;
@@ -281,8 +281,7 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    current_mass_factor_ = c_mass;
-    hand_system_to_solver();
+    hand_system_to_solver(c_mass);
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

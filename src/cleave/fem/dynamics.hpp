@@ -110,8 +110,9 @@ class Dynamics {
   Vector external_forces() const;
   /// system_blocks_ = c_stiff K_R + c_mass M in one gather (no separate K_R, no scaling pass).
   void assemble_system(double c_stiff, double c_mass);
-  /// Gives the solver the assembled system: block values where it takes them, else system_.
-  void hand_system_to_solver();
+  /// Gives the solver the assembled system (mass term c_mass): block values where it takes
+  /// them, else system_.
+  void hand_system_to_solver(double c_mass);
   void compute_acceleration();
 
   const TissueModel& model_;
@@ -138,7 +139,6 @@ class Dynamics {
   /// from, as the solver knew it (kNone: unknown, the solver is set up afresh).
   std::vector<VertexId> origin_of_new_;
   double solver_mass_factor_ = 0;  ///< c_m of the matrix the solver was set up with (1/s^2)
-  double current_mass_factor_ = 0;  ///< c_m of the system assembled for this step
   std::vector<Mat3> rotations_;
   Vector u_, v_, a_;
   double time_s_ = 0;
