@@ -155,11 +155,14 @@ TEST(ExtremeValues, ACellHangingByOneFaceAndACellCutLooseStayFiniteAndObeyMoment
 }
 
 TEST(ExtremeValues, WithoutNumericalDampingTheDivergenceIsReportedNotReturned) {
-  // The average acceleration rule (no numerical damping) lets these pieces gain energy without
-  // bound; the step must stop with a message before the numbers leave the model.
+  // The average acceleration rule (no numerical damping) with the classic frozen-rotation step
+  // lets these pieces gain energy without bound; the step must stop with a message before the
+  // numbers leave the model. (With the stress stiffness they do not diverge within 1000 steps,
+  // but undamped they still tumble far from any rest: the numerical damping is what settles them.)
   DegenerateCuts d;
   DynamicsSettings settings = d.settings();
   settings.numerical_damping = 0;
+  settings.stress_stiffness = false;
   Dynamics sim(d.model, d.stress(), settings);
   d.cut(sim);
   try {

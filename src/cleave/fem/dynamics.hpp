@@ -61,6 +61,12 @@ struct DynamicsSettings {
   Vec3 gravity_mm_per_s2 = Vec3::Zero();
   double numerical_damping = 0.2;       ///< HHT alpha = -this (0 to 1/3): gamma = 1/2 + this, beta = (1 + this)^2 / 4
   Vector external_force_mN;             ///< constant nodal forces (3 n_v); empty = none
+  /// With residual stress, the step's system includes the initial-stress stiffness of the tension
+  /// each cell carries (residual plus elastic, fem/stress_stiffness.hpp): the change of the stress
+  /// forces as cells rotate, which the frozen-rotation step misses. false (and stress-free bodies):
+  /// the classic corotational step, which a free shell under unbalanced tension of the order of E
+  /// made diverge within 0.2 s at dt = 1/60 s.
+  bool stress_stiffness = true;
 };
 
 class Dynamics {
@@ -108,8 +114,9 @@ class Dynamics {
   /// damping force of `velocity` from the same per-cell pass (K_R is never assembled for it).
   Vector internal_forces(const Vector* velocity = nullptr) const;
   Vector external_forces() const;
-  /// system_blocks_ = c_stiff K_R + c_mass M in one gather (no separate K_R, no scaling pass).
-  void assemble_system(double c_stiff, double c_mass);
+  /// system_blocks_ = c_stiff K_R + c_stress K_sigma + c_mass M in one gather (no separate K_R,
+  /// no scaling pass); K_sigma from tension_kPa_.
+  void assemble_system(double c_stiff, double c_stress, double c_mass);
   /// Gives the solver the assembled system (mass term c_mass): block values where it takes
   /// them, else system_.
   void hand_system_to_solver(double c_mass);
@@ -140,6 +147,7 @@ class Dynamics {
   std::vector<VertexId> origin_of_new_;
   double solver_mass_factor_ = 0;  ///< c_m of the matrix the solver was set up with (1/s^2)
   std::vector<Mat3> rotations_;
+  std::vector<Vec6> tension_kPa_;  ///< per cell, for the stress stiffness (empty: not included)
   Vector u_, v_, a_;
   double time_s_ = 0;
 };

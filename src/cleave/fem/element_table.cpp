@@ -9,6 +9,7 @@ ElementTable make_element_table(const TissueModel& model) {
   const LinkedVolume& volume = model.volume;
   table.cell_size_mm = volume.grid().cell_size_mm;
   table.stress_divergence = hex8_stress_divergence(table.cell_size_mm);
+  table.stress_stiffness = hex8_stress_stiffness_basis(table.cell_size_mm);
   table.slot_of_label.fill(-1);
   for (CellId c = 0; c < volume.cell_count(); ++c) {
     const Label label = volume.cell_label(c);

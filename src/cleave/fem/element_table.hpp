@@ -24,6 +24,7 @@ struct ElementMatrices {
 struct ElementTable {
   double cell_size_mm = 1.0;
   Mat24x6 stress_divergence;  ///< T^e = integral of B^T (mm^2); material independent
+  std::array<Mat8, 6> stress_stiffness;  ///< G_k (mm): initial-stress stiffness per Voigt component
   std::array<int, 256> slot_of_label{};  ///< label -> index into per_material (-1 = label absent)
   std::vector<ElementMatrices> per_material;
 

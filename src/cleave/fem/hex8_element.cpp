@@ -89,6 +89,23 @@ Mat24x6 hex8_stress_divergence(double h_mm) {
   return t;
 }
 
+std::array<Mat8, 6> hex8_stress_stiffness_basis(double h_mm) {
+  // Voigt k -> (i, j): xx, yy, zz, xy, xz, yz.
+  constexpr std::array<std::array<int, 2>, 6> kIndices{{{0, 0}, {1, 1}, {2, 2}, {0, 1}, {0, 2}, {1, 2}}};
+  std::array<Mat8, 6> g;
+  for (Mat8& m : g) m.setZero();
+  for_each_gauss_point(h_mm, [&](const Vec3& xi, double w) {
+    const Eigen::Matrix<double, 8, 3> grad = shape_gradients_local(xi) / h_mm;
+    for (int k = 0; k < 6; ++k) {
+      const int i = kIndices[static_cast<std::size_t>(k)][0], j = kIndices[static_cast<std::size_t>(k)][1];
+      Mat8 term = grad.col(i) * grad.col(j).transpose();
+      if (i != j) term += grad.col(j) * grad.col(i).transpose();
+      g[static_cast<std::size_t>(k)] += w * term;
+    }
+  });
+  return g;
+}
+
 Mat24 hex8_consistent_mass(double h_mm, double density_kg_per_mm3) {
   Mat24 m = Mat24::Zero();
   for_each_gauss_point(h_mm, [&](const Vec3& xi, double w) {

@@ -4,6 +4,8 @@
 // Nodal vectors are 24 long, ordered (x0, y0, z0, x1, y1, z1, ...). Voigt order xx, yy, zz, xy,
 // xz, yz with engineering shear strains (gamma_xy = 2 eps_xy).
 // Units: h in mm, E in kPa, density in kg/mm^3 -> K in mN/mm, T in mm^2, M in kg.
+#include <array>
+
 #include <Eigen/Core>
 
 #include "cleave/core/types.hpp"
@@ -31,6 +33,14 @@ Mat24 hex8_stiffness(double h_mm, const Mat6& elasticity);
 /// T^e = integral of B^T over the cube: maps a constant cell stress (Voigt) to the 24 nodal
 /// forces it exerts (f = -T^e sigma on the nodes is the internal force of a pre-stressed cell).
 Mat24x6 hex8_stress_divergence(double h_mm);
+
+/// The initial-stress (geometric) stiffness of a cube under a constant stress sigma (Voigt, kPa)
+/// is sum_k sigma_k G_k (x) I_3: G_k(a, b) = integral of grad N_a^T E_k grad N_b, E_k the unit
+/// symmetric tensor of Voigt component k (E_xy has 1 at xy and yx). Units: mm.
+/// Sum over b of G(a, b) X_b = (T^e sigma)_a: for a rigid rotation it is the change of the
+/// rotated stress forces.
+using Mat8 = Eigen::Matrix<double, 8, 8>;
+std::array<Mat8, 6> hex8_stress_stiffness_basis(double h_mm);
 
 /// Consistent mass integral of rho N^T N (24x24); density in kg/mm^3.
 Mat24 hex8_consistent_mass(double h_mm, double density_kg_per_mm3);

@@ -1,0 +1,40 @@
+#pragma once
+// The initial-stress (geometric) stiffness of corotated cells. A cell's force R (K^e d + T^e s)
+// turns with the cell: for an increment that rotates it rigidly by dtheta, the force changes by
+// dtheta x f. The frozen-rotation step of corotational dynamics misses that change; under tissue
+// tension of the order of E it then grows rotations of loose pieces from step to step (a free
+// shell under 20 kPa of unbalanced tension diverged within 0.2 s at dt = 1/60 s). The standard
+// geometric stiffness of the stress the cell carries, sum_k s_k G_k (x) I_3 per block (hex8_element:
+// hex8_stress_stiffness_basis), gives exactly dtheta x f for rigid rotations. Only the tensile part
+// of the stress is taken, so that the step's system stays positive definite (compression would
+// soften it; its buckling is left to the exact forces).
+//
+//   corotated_cell_tension(volume, table, residual_kPa, u, rotations, tension);  // per cell
+//   block(a, b) += stress_stiffness_coefficient(table, tension[c], a, b) * I_3;  // mN/mm
+#include <span>
+#include <vector>
+
+#include "cleave/fem/element_table.hpp"
+#include "cleave/grid/linked_volume.hpp"
+#include "cleave/solve/linear_solver.hpp"
+
+namespace cleave {
+
+/// The tensile part of a symmetric stress (Voigt, kPa): its negative eigenvalues set to zero.
+Vec6 tensile_part(const Vec6& stress_kPa);
+
+/// Per cell, the tensile part of the stress it carries in its corotated frame: the residual stress
+/// (empty: none) plus D (sym(R^T F) - I) at the cell centre, F from `displacement_mm` (3 n_v) and R
+/// from `rotations` (one per cell). Computed in parallel; `tension_kPa` is resized.
+void corotated_cell_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                            const Vector& displacement_mm, const std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
+
+/// The coefficient of I_3 in block (a, b) of the initial-stress stiffness of a cell that carries
+/// `stress_kPa` (mN/mm): sum over the Voigt components k of stress_k G_k(a, b).
+inline double stress_stiffness_coefficient(const ElementTable& table, const Vec6& stress_kPa, int a, int b) {
+  double sum = 0;
+  for (std::size_t k = 0; k < 6; ++k) sum += stress_kPa[static_cast<Eigen::Index>(k)] * table.stress_stiffness[k](a, b);
+  return sum;
+}
+
+}  // namespace cleave
