@@ -14,7 +14,9 @@
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/hex8_element.hpp"
 #include "cleave/fem/stress_stiffness.hpp"
+#include "cleave/fem/corotation.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
+#include "fem_test_models.hpp"
 
 namespace cleave {
 namespace {
@@ -73,6 +75,39 @@ TEST(StressStiffness, TensilePartDropsTheCompressiveEigenvalues) {
   EXPECT_LT((tensile_part(rotated({20, -8, 5})) - rotated({20, 0, 5})).norm(), 1e-12 * 20);
   EXPECT_EQ(tensile_part(rotated({20, 8, 5})), rotated({20, 8, 5}));  // tension stays as it is
   EXPECT_EQ(tensile_part(rotated({-20, -8, -5})), Vec6::Zero());
+  EXPECT_LT((tensile_part(rotated({-20, 8, -5})) - rotated({0, 8, 0})).norm(), 1e-12 * 20);
+}
+
+TEST(StressStiffness, ACellCarriesItsResidualStressPlusTheElasticStressOfItsStretchInItsOwnFrame) {
+  // Every vertex moved by x -> R S x (S a stretch, R a large rotation): each cell's corotated
+  // stress is the residual one plus D (S - I), whatever R is; its tensile part is what is kept.
+  const TissueModel model = test::make_box_model({3, 2, 2}, 2.0, 80.0, 0.4);
+  const LinkedVolume& volume = model.volume;
+  const ElementTable table = make_element_table(model);
+  const Mat3 r = Eigen::AngleAxisd(1.1, Vec3(0.3, -1, 0.5).normalized()).toRotationMatrix();
+  Mat3 stretch;
+  stretch << 1.02, 0.004, 0, 0.004, 0.99, 0.003, 0, 0.003, 1.01;
+  Vector u(3 * volume.vertex_count());
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    const Vec3 x = volume.vertex_position_mm(v);
+    u.segment<3>(3 * v) = r * stretch * x - x;
+  }
+  Vec6 residual;
+  residual << 5, -12, 2, 1, 0, -0.5;
+  const std::vector<Vec6> residual_per_cell(static_cast<std::size_t>(volume.cell_count()), residual);
+  std::vector<Mat3> rotations;
+  std::vector<Vec6> tension;
+  cell_rotations_and_tension(volume, table, residual_per_cell, u, rotations, tension);
+  Vec6 strain = to_voigt(stretch - Mat3::Identity());
+  strain.tail<3>() *= 2.0;
+  const Vec6 expected = tensile_part(residual + table.per_material[0].elasticity_kPa * strain);
+  ASSERT_EQ(tension.size(), static_cast<std::size_t>(volume.cell_count()));
+  for (const Vec6& t : tension) EXPECT_LT((t - expected).norm(), 1e-9 * expected.norm());
+  for (const Mat3& rotation : rotations) EXPECT_LT((rotation - r).norm(), 1e-12);
+  EXPECT_GT(expected.norm(), 1.0);  // the compressive -12 kPa was dropped, the rest kept
+  // Stress free at rest: no tension.
+  cell_rotations_and_tension(volume, table, {}, Vector::Zero(u.size()), rotations, tension);
+  for (const Vec6& t : tension) EXPECT_EQ(t, Vec6::Zero());
 }
 
 /// The bench's prescribed biaxial stress: `along_kPa` around the z axis through the box centre,

@@ -256,12 +256,13 @@ SolveReport Dynamics::step(double dt) {
   const double alpha_m = settings_.mass_damping_per_s;
   const double beta_k = settings_.stiffness_damping_s;
 
-  update_rotations();
   // A stress-free body keeps the classic corotational step: its stresses come from its own
   // deformation, and the tensile part alone would make bending oscillations drift in energy
   // (5.9 % over 1000 undamped steps of the cantilever instead of < 1 %).
   if (settings_.stress_stiffness && !stress_kPa_.empty())
-    corotated_cell_tension(model_.volume, table_, stress_kPa_, u_, rotations_, tension_kPa_);
+    cell_rotations_and_tension(model_.volume, table_, stress_kPa_, u_, rotations_, tension_kPa_);
+  else
+    update_rotations();
   // HHT: M a(n+1) + w [D v(n+1) + f_int(n+1)] + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - a,
   // with f_int(n+1) ~ f_int(n) + (K_R + K_sigma) du (R frozen over the step; K_sigma: how the
   // stress forces turn with the cells) and v(n+1) = gamma du / (beta dt) + damping_part.

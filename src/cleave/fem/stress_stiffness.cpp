@@ -7,25 +7,38 @@
 #include "cleave/fem/corotation.hpp"
 
 namespace cleave {
+namespace {
 
-Vec6 tensile_part(const Vec6& stress_kPa) {
-  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-  eigen.computeDirect(from_voigt(stress_kPa));
-  const Vec3 values = eigen.eigenvalues();
-  if (values.minCoeff() >= 0) return stress_kPa;
-  if (values.maxCoeff() <= 0) return Vec6::Zero();
-  const Mat3& axes = eigen.eigenvectors();
-  return to_voigt(axes * values.cwiseMax(0.0).asDiagonal() * axes.transpose());
+/// All principal minors non-negative (Sylvester's criterion for semi-definiteness).
+bool positive_semidefinite(const Vec6& s) {
+  return s[0] >= 0 && s[1] >= 0 && s[2] >= 0 && s[0] * s[1] >= s[3] * s[3] && s[0] * s[2] >= s[4] * s[4] &&
+         s[1] * s[2] >= s[5] * s[5] && from_voigt(s).determinant() >= 0;
 }
 
-void corotated_cell_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
-                            const Vector& displacement_mm, const std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa) {
-  tension_kPa.resize(static_cast<std::size_t>(volume.cell_count()));
+}  // namespace
+
+Vec6 tensile_part(const Vec6& stress_kPa) {
+  // Most cells of tissue under tension are wholly tensile, the rest often wholly compressive:
+  // the eigen decomposition only for the mixed ones.
+  if (positive_semidefinite(stress_kPa)) return stress_kPa;
+  if (positive_semidefinite(-stress_kPa)) return Vec6::Zero();
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+  eigen.computeDirect(from_voigt(stress_kPa));
+  const Mat3& axes = eigen.eigenvectors();
+  return to_voigt(axes * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * axes.transpose());
+}
+
+void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                                const Vector& displacement_mm, std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa) {
+  const auto cells = static_cast<std::size_t>(volume.cell_count());
+  rotations.resize(cells);
+  tension_kPa.resize(cells);
   const double h = table.cell_size_mm;
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
     for (CellId c = r.begin(); c != r.end(); ++c) {
       const auto ci = static_cast<std::size_t>(c);
       const Mat3 f = hex8_center_deformation_gradient(cell_displacement(volume, c, displacement_mm), h);
+      rotations[ci] = rotation_from_deformation_gradient(f);
       const Mat3 stretch = rotations[ci].transpose() * f;
       Vec6 strain = to_voigt(0.5 * (stretch + stretch.transpose()) - Mat3::Identity());
       strain.tail<3>() *= 2.0;  // engineering shear

@@ -9,7 +9,7 @@
 // of the stress is taken, so that the step's system stays positive definite (compression would
 // soften it; its buckling is left to the exact forces).
 //
-//   corotated_cell_tension(volume, table, residual_kPa, u, rotations, tension);  // per cell
+//   cell_rotations_and_tension(volume, table, residual_kPa, u, rotations, tension);  // per cell
 //   block(a, b) += stress_stiffness_coefficient(table, tension[c], a, b) * I_3;  // mN/mm
 #include <span>
 #include <vector>
@@ -23,11 +23,11 @@ namespace cleave {
 /// The tensile part of a symmetric stress (Voigt, kPa): its negative eigenvalues set to zero.
 Vec6 tensile_part(const Vec6& stress_kPa);
 
-/// Per cell, the tensile part of the stress it carries in its corotated frame: the residual stress
-/// (empty: none) plus D (sym(R^T F) - I) at the cell centre, F from `displacement_mm` (3 n_v) and R
-/// from `rotations` (one per cell). Computed in parallel; `tension_kPa` is resized.
-void corotated_cell_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
-                            const Vector& displacement_mm, const std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
+/// Per cell, in one pass: the rotation R of F = R S at the cell centre (as cell_rotations) and the
+/// tensile part of the stress the cell carries in its corotated frame, the residual stress (empty:
+/// none) plus D (S - I), F from `displacement_mm` (3 n_v). In parallel; both outputs are resized.
+void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                                const Vector& displacement_mm, std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
 
 /// The coefficient of I_3 in block (a, b) of the initial-stress stiffness of a cell that carries
 /// `stress_kPa` (mN/mm): sum over the Voigt components k of stress_k G_k(a, b).
