@@ -65,7 +65,7 @@ struct DynamicsSettings {
   /// each cell carries (residual plus elastic, fem/stress_stiffness.hpp): the change of the stress
   /// forces as cells rotate, which the frozen-rotation step misses. false (and stress-free bodies):
   /// the classic corotational step, which a free shell under unbalanced tension of the order of E
-  /// made diverge within 0.2 s at dt = 1/60 s.
+  /// made diverge within 0.2-0.5 s at dt = 1/60 s.
   bool stress_stiffness = true;
 };
 

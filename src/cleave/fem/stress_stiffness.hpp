@@ -3,7 +3,7 @@
 // turns with the cell: for an increment that rotates it rigidly by dtheta, the force changes by
 // dtheta x f. The frozen-rotation step of corotational dynamics misses that change; under tissue
 // tension of the order of E it then grows rotations of loose pieces from step to step (a free
-// shell under 20 kPa of unbalanced tension diverged within 0.2 s at dt = 1/60 s). The standard
+// shell under 20 kPa of unbalanced tension diverged within 0.2-0.5 s at dt = 1/60 s). The standard
 // geometric stiffness of the stress the cell carries, sum_k s_k G_k (x) I_3 per block (hex8_element:
 // hex8_stress_stiffness_basis), gives exactly dtheta x f for rigid rotations. Only the tensile part
 // of the stress is taken, so that the step's system stays positive definite (compression would
