@@ -34,11 +34,7 @@ std::vector<Vec6> total_cell_stress_kPa(const TissueModel& model, std::span<cons
       f = hex8_center_deformation_gradient(ue, h);
     }
     const Mat3 r = rotation_from_deformation_gradient(f);
-    const Mat3 stretch = r.transpose() * f;
-    const Mat3 eps = 0.5 * (stretch + stretch.transpose()) - Mat3::Identity();
-    Vec6 strain = to_voigt(eps);
-    strain.tail<3>() *= 2.0;  // engineering shear
-    const Vec6 local = res + table.of_label(volume.cell_label(c)).elasticity_kPa * strain;
+    const Vec6 local = res + table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, r);
     out[ci] = to_voigt(r * from_voigt(local) * r.transpose());
   }
   return out;

@@ -55,6 +55,13 @@ Vec24 cell_displacement(const LinkedVolume& volume, CellId c, const Vector& u) {
   return ue;
 }
 
+Vec6 corotated_strain(const Mat3& f, const Mat3& r) {
+  const Mat3 stretch = r.transpose() * f;
+  Vec6 strain = to_voigt(0.5 * (stretch + stretch.transpose()) - Mat3::Identity());
+  strain.tail<3>() *= 2.0;  // engineering shear
+  return strain;
+}
+
 void cell_rotations(const LinkedVolume& volume, const Vector& u, std::vector<Mat3>& rotations) {
   rotations.resize(static_cast<std::size_t>(volume.cell_count()));
   const double h = volume.grid().cell_size_mm;

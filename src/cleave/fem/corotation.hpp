@@ -18,6 +18,10 @@ Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
 /// The same by the SVD alone (the reference the Newton iteration is tested against).
 Mat3 rotation_by_svd(const Mat3& deformation_gradient);
 
+/// The strain of F = R S in the frame turned by R: sym(R^T F) - I, as Voigt with engineering
+/// shear (what D multiplies).
+Vec6 corotated_strain(const Mat3& deformation_gradient, const Mat3& rotation);
+
 /// R per cell for vertex displacements `u` (3 n_v, mm); computed in parallel.
 void cell_rotations(const LinkedVolume& volume, const Vector& displacement_mm, std::vector<Mat3>& rotations);
 

@@ -39,10 +39,7 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
       const auto ci = static_cast<std::size_t>(c);
       const Mat3 f = hex8_center_deformation_gradient(cell_displacement(volume, c, displacement_mm), h);
       rotations[ci] = rotation_from_deformation_gradient(f);
-      const Mat3 stretch = rotations[ci].transpose() * f;
-      Vec6 strain = to_voigt(0.5 * (stretch + stretch.transpose()) - Mat3::Identity());
-      strain.tail<3>() *= 2.0;  // engineering shear
-      Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * strain;
+      Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, rotations[ci]);
       if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
       tension_kPa[ci] = tensile_part(stress);
     }
