@@ -64,6 +64,7 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
         static_cast<std::int32_t>(std::lower_bound(begin, end, static_cast<std::int32_t>(v)) - system_blocks_.column.begin());
   }
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
+  system_operator_.set_topology(model_.volume, table_);
   update_rotations();
 }
 
@@ -225,6 +226,15 @@ void Dynamics::hand_system_to_solver(double c_mass) {
   origin_of_new_.clear();
 }
 
+bool Dynamics::hand_operator_to_solver(double c_stiff, double c_stress, double c_mass) {
+  if (!solver_ready_ || solver_mass_factor_ != c_mass || !origin_of_new_.empty() || solver_vertices_ != model_.volume.vertex_count())
+    return false;
+  system_operator_.set_state(rotations_, tension_kPa_, c_stiff, c_stress, c_mass, mass_, fixed_);
+  if (!solver_->update_operator(system_operator_, model_.volume)) return false;
+  ++matrix_free_steps_;
+  return true;
+}
+
 void Dynamics::compute_acceleration() {
   Vector net = external_forces() - internal_forces(&v_);
   if (settings_.mass_damping_per_s > 0) net -= settings_.mass_damping_per_s * mass_.cwiseProduct(v_);
@@ -278,23 +288,28 @@ SolveReport Dynamics::step(double dt) {
   Vector rhs = external_forces() - internal_forces(&damped_velocity) + mass_.cwiseProduct(inertia_part);
   if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damped_velocity);
 
-  assemble_system(c_stiff, w, c_mass);
-  if (any_fixed_) {
-    FixedDofs held;
-    held.fixed = fixed_;
-    held.value_mm = Vector::Zero(u_.size());
-    eliminate_fixed_dofs(system_blocks_, rhs, held);
-  }
-
+  // Fixed dofs are held at zero: their rows are identity rows with a zero right-hand side.
   Vector du = dt * v_ + 0.5 * dt * dt * a_;  // Newmark predictor: warm start
   for (std::size_t i = 0; i < fixed_.size(); ++i)
-    if (fixed_[i] != 0) du[static_cast<Eigen::Index>(i)] = 0.0;
+    if (fixed_[i] != 0) {
+      du[static_cast<Eigen::Index>(i)] = 0.0;
+      rhs[static_cast<Eigen::Index>(i)] = 0.0;
+    }
   SolveReport report;
   if (rhs.lpNorm<Eigen::Infinity>() == 0.0) {
     du.setZero();
     report.converged = true;
   } else {
-    hand_system_to_solver(c_mass);
+    if (!(settings_.matrix_free && hand_operator_to_solver(c_stiff, w, c_mass))) {
+      assemble_system(c_stiff, w, c_mass);
+      if (any_fixed_) {
+        FixedDofs held;
+        held.fixed = fixed_;
+        held.value_mm = Vector::Zero(u_.size());
+        eliminate_fixed_dofs(system_blocks_, rhs, held);
+      }
+      hand_system_to_solver(c_mass);
+    }
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));
   }

@@ -34,6 +34,7 @@
 #include <string>
 #include <vector>
 
+#include "cleave/fem/corotated_system_operator.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/model/tissue_model.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
@@ -67,6 +68,12 @@ struct DynamicsSettings {
   /// the classic corotational step, which a free shell under unbalanced tension of the order of E
   /// made diverge within 0.2-0.5 s at dt = 1/60 s.
   bool stress_stiffness = true;
+  /// The step's system is applied cell by cell (fem/corotated_system_operator.hpp) where the
+  /// solver takes it so (the multigrid, between its rebuilds): no assembly of its blocks, and
+  /// products that read the cells' rotations instead of the 3x3 blocks. The assembled matrix is
+  /// still gathered for a setup, a cut and the other solvers. false: assembled every step (the
+  /// reference path: both solve the same system).
+  bool matrix_free = true;
 };
 
 class Dynamics {
@@ -96,6 +103,8 @@ class Dynamics {
   double time_s() const { return time_s_; }
   std::string_view solver_name() const;
   const std::vector<std::uint8_t>& fixed_dofs() const { return fixed_; }
+  /// Steps whose system the solver took as the cell-by-cell operator (DynamicsSettings::matrix_free).
+  int matrix_free_steps() const { return matrix_free_steps_; }
 
   /// 1/2 v^T M v (uJ = kg mm^2 / s^2 = mN mm).
   double kinetic_energy_uJ() const;
@@ -120,6 +129,9 @@ class Dynamics {
   /// Gives the solver the assembled system (mass term c_mass): block values where it takes
   /// them, else system_.
   void hand_system_to_solver(double c_mass);
+  /// Gives the solver the system as system_operator_ (no assembly) where it takes it: the
+  /// topology and the mass term are those it was last given. false: assemble.
+  bool hand_operator_to_solver(double c_stiff, double c_stress, double c_mass);
   void compute_acceleration();
 
   const TissueModel& model_;
@@ -135,6 +147,7 @@ class Dynamics {
   /// with the solver's older ones; every step overwrites all of them).
   BlockSparseMatrix<double> system_blocks_;
   VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
+  CorotatedSystemOperator system_operator_;  ///< the same system applied cell by cell
   std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_
   /// The same matrix as scalar CSR (vertex block pattern of the topology), filled from the blocks
   /// only when a solver asks for it (setup, a cut, CHOLMOD).
@@ -150,6 +163,7 @@ class Dynamics {
   std::vector<Vec6> tension_kPa_;  ///< per cell, for the stress stiffness (empty: not included)
   Vector u_, v_, a_;
   double time_s_ = 0;
+  int matrix_free_steps_ = 0;
 };
 
 }  // namespace cleave

@@ -17,7 +17,8 @@ constexpr std::size_t kVerticesPerTask = 1024;
 /// A block counts as singular when |det| falls below this times its norm cubed (scale free).
 constexpr double kRelativeDeterminantFloor = 1e-14;
 
-/// The inverse of a vertex block, or the identity when it is singular (no NaN ever).
+}  // namespace
+
 Mat3 inverse_or_identity(const Mat3& block) {
   Mat3 inverse;
   bool invertible = false;
@@ -26,8 +27,6 @@ Mat3 inverse_or_identity(const Mat3& block) {
   block.computeInverseAndDetWithCheck(inverse, determinant, invertible, kRelativeDeterminantFloor * scale * scale * scale);
   return (invertible && inverse.allFinite()) ? inverse : Mat3::Identity();
 }
-
-}  // namespace
 
 template <typename Scalar>
 std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<Scalar>& a) {

@@ -25,6 +25,10 @@ class BlockJacobi final : public Preconditioner {
 
 BlockJacobi block_jacobi(const SparseMatrix& a);
 
+/// The inverse of a vertex block, or the identity when it is singular (|det| below 1e-14 of its
+/// norm cubed): no NaN ever.
+Mat3 inverse_or_identity(const Mat3& block);
+
 /// The same inverse blocks (in double), from a block CSR matrix (float or double).
 template <typename Scalar>
 std::vector<Mat3> inverse_diagonal_blocks(const BlockSparseMatrix<Scalar>& a);

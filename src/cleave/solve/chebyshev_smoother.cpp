@@ -91,9 +91,21 @@ void ChebyshevSmoother::smooth(const BlockSparseMatrix<Scalar>& a, const Eigen::
   iterate(a, b, x, work, Start::from_x);
 }
 
-// Chebyshev iteration on [lower, upper] (Saad, Iterative Methods, algorithm 12.1) with D^-1.
 template <typename Scalar>
-void ChebyshevSmoother::iterate(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+void ChebyshevSmoother::smooth_from_zero(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                         Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const {
+  iterate(a, b, x, work, Start::from_zero);
+}
+
+template <typename Scalar>
+void ChebyshevSmoother::smooth(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const {
+  iterate(a, b, x, work, Start::from_x);
+}
+
+// Chebyshev iteration on [lower, upper] (Saad, Iterative Methods, algorithm 12.1) with D^-1.
+template <typename Matrix, typename Scalar>
+void ChebyshevSmoother::iterate(const Matrix& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
                                 Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work, Start start) const {
   const auto& inverse = inverse_blocks<Scalar>();
   const double upper = lambda_max;
@@ -134,6 +146,14 @@ template void ChebyshevSmoother::smooth_from_zero<double>(const BlockSparseMatri
 template void ChebyshevSmoother::smooth<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, Eigen::VectorXf&,
                                                ChebyshevWork<float>&) const;
 template void ChebyshevSmoother::smooth<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, Eigen::VectorXd&,
+                                                ChebyshevWork<double>&) const;
+template void ChebyshevSmoother::smooth_from_zero<float>(const VertexOperator&, const Eigen::VectorXf&, Eigen::VectorXf&,
+                                                         ChebyshevWork<float>&) const;
+template void ChebyshevSmoother::smooth_from_zero<double>(const VertexOperator&, const Eigen::VectorXd&, Eigen::VectorXd&,
+                                                          ChebyshevWork<double>&) const;
+template void ChebyshevSmoother::smooth<float>(const VertexOperator&, const Eigen::VectorXf&, Eigen::VectorXf&,
+                                               ChebyshevWork<float>&) const;
+template void ChebyshevSmoother::smooth<double>(const VertexOperator&, const Eigen::VectorXd&, Eigen::VectorXd&,
                                                 ChebyshevWork<double>&) const;
 
 }  // namespace cleave

@@ -15,6 +15,7 @@
 // by a safety factor.
 #include "cleave/solve/block_jacobi.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
+#include "cleave/solve/vertex_operator.hpp"
 
 namespace cleave {
 
@@ -49,12 +50,19 @@ class ChebyshevSmoother {
   template <typename Scalar>
   void smooth(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const;
+  /// The same with A applied without its matrix (the dynamic step's fine level).
+  template <typename Scalar>
+  void smooth_from_zero(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                        Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const;
+  template <typename Scalar>
+  void smooth(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work) const;
 
  private:
   enum class Start { from_zero, from_x };
-  template <typename Scalar>
-  void iterate(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
-               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, ChebyshevWork<Scalar>& work, Start start) const;
+  template <typename Matrix, typename Scalar>
+  void iterate(const Matrix& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+               ChebyshevWork<Scalar>& work, Start start) const;
 };
 
 /// D^-1 and the lambda_max estimate from `a` (power iteration in a's precision).

@@ -96,4 +96,9 @@ SolveReport preconditioned_cg(const BlockSparseMatrix<double>& a, const Vector& 
   return preconditioned_cg_any(a, b, x, preconditioner, settings);
 }
 
+SolveReport preconditioned_cg(const VertexOperator& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings) {
+  return preconditioned_cg_any(a, b, x, preconditioner, settings);
+}
+
 }  // namespace cleave

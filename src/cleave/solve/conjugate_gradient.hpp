@@ -16,6 +16,7 @@
 // x never holds NaN. Restarts from the true residual when rounding drift fools the recurrence.
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/linear_solver.hpp"
+#include "cleave/solve/vertex_operator.hpp"
 
 namespace cleave {
 
@@ -36,6 +37,9 @@ SolveReport preconditioned_cg(const SparseMatrix& a, const Vector& b, Vector& x,
                               const SolveSettings& settings);
 /// The same on a block CSR matrix (fewer bytes per product; block_sparse_matrix.hpp).
 SolveReport preconditioned_cg(const BlockSparseMatrix<double>& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
+                              const SolveSettings& settings);
+/// The same with A applied without its matrix (solve/vertex_operator.hpp).
+SolveReport preconditioned_cg(const VertexOperator& a, const Vector& b, Vector& x, const Preconditioner& preconditioner,
                               const SolveSettings& settings);
 
 }  // namespace cleave

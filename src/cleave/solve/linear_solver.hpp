@@ -16,6 +16,7 @@ using SparseMatrix = Eigen::SparseMatrix<double, Eigen::RowMajor>;
 using Vector = Eigen::VectorXd;
 template <typename Scalar>
 struct BlockSparseMatrix;  // block_sparse_matrix.hpp
+class VertexOperator;      // vertex_operator.hpp
 
 enum class SolverKind {
   multigrid_cg,  ///< cleave's default: CG preconditioned by a cut-aware geometric multigrid V-cycle
@@ -76,6 +77,16 @@ class LinearSolver {
   /// takes nothing, when the solver needs the scalar matrix for this update (a rebuild is due,
   /// or it works on scalar CSR): the caller then calls update_values() with it.
   virtual bool update_block_values(BlockSparseMatrix<double>& a, const LinkedVolume& topology) {
+    (void)a;
+    (void)topology;
+    return false;
+  }
+  /// Like update_block_values() with the new matrix applied without its values (the dynamic
+  /// step's corotated system, same topology and fixed dofs as the last update): the solver
+  /// multiplies with `a` until the next update (it is referenced and must outlive the solves).
+  /// Returns false, and takes nothing, when the solver needs the assembled matrix for this update
+  /// (a rebuild is due, or it cannot work without it: the default).
+  virtual bool update_operator(const VertexOperator& a, const LinkedVolume& topology) {
     (void)a;
     (void)topology;
     return false;

@@ -27,6 +27,7 @@ class MultigridCgSolver final : public LinearSolver {
 
   void setup(const SparseMatrix& a, const LinkedVolume& topology) override {
     preconditioner_ = MultigridPreconditioner();  // drops the reference to the old matrix first
+    operator_ = nullptr;
     a_ = a;
     a_.makeCompressed();
     a_blocks_ = to_block_sparse<double>(a_);
@@ -43,6 +44,7 @@ class MultigridCgSolver final : public LinearSolver {
     // Only the block copy follows the new values: a_ (scalar CSR) is what the levels were built
     // from and is read again only by the next setup.
     refresh_block_values(a, a_blocks_);
+    operator_ = nullptr;
     preconditioner_.refresh_fine_level(a_blocks_);
     ++stale_updates_;
     topology_ = &topology;
@@ -53,7 +55,19 @@ class MultigridCgSolver final : public LinearSolver {
         a.column != a_blocks_.column)
       return false;
     a_blocks_.values.swap(a.values);  // no 100 MB copy per time step at 44k cells
+    operator_ = nullptr;
     preconditioner_.refresh_fine_level(a_blocks_);
+    ++stale_updates_;
+    topology_ = &topology;
+    return true;
+  }
+
+  bool update_operator(const VertexOperator& a, const LinkedVolume& topology) override {
+    if (rebuild_requested_ || stale_updates_ >= options_.max_stale_updates || a.rows() != a_.rows() ||
+        preconditioner_.levels().size() < 2)
+      return false;
+    preconditioner_.use_fine_operator(a, a.inverse_diagonal_blocks());
+    operator_ = &a;
     ++stale_updates_;
     topology_ = &topology;
     return true;
@@ -83,6 +97,8 @@ class MultigridCgSolver final : public LinearSolver {
     if (stale.converged || stale.iterations >= settings_.max_iterations) return track(stale);
     // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
     preconditioner_ = MultigridPreconditioner();
+    if (operator_ != nullptr) operator_->assemble(a_blocks_);
+    operator_ = nullptr;
     copy_block_values(a_blocks_, a_);
     build(*topology_);
     const SolveSettings rest = continuation(settings_, stale, settings_.max_iterations - stale.iterations);
@@ -115,6 +131,7 @@ class MultigridCgSolver final : public LinearSolver {
       return;
     }
     a_ = a;
+    operator_ = nullptr;
     a_blocks_ = blocks != nullptr ? *blocks : to_block_sparse<double>(a_);
     preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
     ++stale_updates_;
@@ -133,19 +150,23 @@ class MultigridCgSolver final : public LinearSolver {
 
   /// CG with the cycle: single precision first, the double cycle if float rounding stalls it.
   SolveReport solve_with(const Vector& b, Vector& x, const SolveSettings& settings) {
-    if (preconditioner_.precision() != CyclePrecision::single_precision)
-      return preconditioned_cg(a_blocks_, b, x, preconditioner_, settings);
+    if (preconditioner_.precision() != CyclePrecision::single_precision) return cg(b, x, settings);
     SolveSettings attempt = settings;
     attempt.max_iterations = std::min(settings.max_iterations, kSinglePrecisionMaxIterations);
-    const SolveReport single = preconditioned_cg(a_blocks_, b, x, preconditioner_, attempt);
+    const SolveReport single = cg(b, x, attempt);
     if (single.converged || single.iterations >= settings.max_iterations) return single;
     // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
     preconditioner_.use_double_precision(a_blocks_);
-    SolveReport report = preconditioned_cg(a_blocks_, b, x, preconditioner_,
-                                           continuation(settings, single, settings.max_iterations - single.iterations));
+    SolveReport report = cg(b, x, continuation(settings, single, settings.max_iterations - single.iterations));
     report.iterations += single.iterations;
     report.initial_relative_residual = single.initial_relative_residual;
     return report;
+  }
+
+  /// CG with the current matrix: the operator when the last update gave one, else the blocks.
+  SolveReport cg(const Vector& b, Vector& x, const SolveSettings& settings) {
+    if (operator_ != nullptr) return preconditioned_cg(*operator_, b, x, preconditioner_, settings);
+    return preconditioned_cg(a_blocks_, b, x, preconditioner_, settings);
   }
 
   /// Remembers the first solve's iterations after a build; a solve far above them asks for a
@@ -159,7 +180,8 @@ class MultigridCgSolver final : public LinearSolver {
   SolveSettings settings_;
   MultigridOptions options_;
   SparseMatrix a_;                      ///< the matrix of the last setup (the levels' source)
-  BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the CG multiplies with
+  BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the CG multiplies with ...
+  const VertexOperator* operator_ = nullptr;  ///< ... unless the last update gave the matrix as an operator
   MultigridPreconditioner preconditioner_;
   int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
   int baseline_iterations_ = -1;  ///< iterations of the first solve after the build

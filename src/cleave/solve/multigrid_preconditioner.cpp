@@ -198,13 +198,14 @@ void MultigridPreconditioner::use_double_precision(const BlockSparseMatrix<doubl
     levels_[l].single = CycleData<float>();
     levels_[l].twin.blocks = l == 0 ? fine : to_block_sparse<double>(levels_[l].matrix);
   }
-  if (levels_.size() > 1) levels_[0].smoother.set_inverse_diagonal(inverse_diagonal_blocks(fine));
+  if (levels_.size() > 1 && fine_operator_ == nullptr) levels_[0].smoother.set_inverse_diagonal(inverse_diagonal_blocks(fine));
   allocate_cycle<double>();
 }
 
 void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>& a) {
   if (levels_.size() < 2) return;  // a single level: the (older) factorization preconditions
   MultigridLevel& fine = levels_[0];
+  fine_operator_ = nullptr;
   if (a.row_start.size() != fine.smoother.inverse_diagonal.size() + 1 ||
       a.blocks() != (precision_ == CyclePrecision::single_precision ? fine.single.blocks.blocks() : fine.twin.blocks.blocks()))
     throw InputError("multigrid: the refreshed matrix does not have the pattern the levels were built from");
@@ -239,6 +240,7 @@ void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const Bl
   }
   transpose_prolongation(p);
   fine_ = &a;
+  fine_operator_ = nullptr;
   fine.fixed = identity_rows(a);
   if (precision_ == CyclePrecision::single_precision) {
     fine.single.blocks = single_precision_copy(blocks);
@@ -251,6 +253,16 @@ void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const Bl
   }
 }
 
+void MultigridPreconditioner::use_fine_operator(const VertexOperator& a, std::vector<Mat3> inverse_diagonal) {
+  if (levels_.size() < 2) return;  // a single level: the (older) factorization preconditions
+  if (a.rows() != static_cast<Eigen::Index>(levels_[0].fixed.size()) ||
+      inverse_diagonal.size() != levels_[0].smoother.inverse_diagonal.size())
+    throw InputError(fmt::format("multigrid: the fine operator has {} rows and {} diagonal blocks; the fine level has {} dofs",
+                                 a.rows(), inverse_diagonal.size(), levels_[0].fixed.size()));
+  fine_operator_ = &a;
+  levels_[0].smoother.set_inverse_diagonal(std::move(inverse_diagonal));
+}
+
 template <typename Scalar>
 void MultigridPreconditioner::cycle(std::size_t l) const {
   const MultigridLevel& level = levels_[l];
@@ -261,7 +273,14 @@ void MultigridPreconditioner::cycle(std::size_t l) const {
     if (!data.solution.allFinite()) data.solution.setZero();
     return;
   }
-  const BlockSparseMatrix<Scalar>& a = data.blocks;
+  if (l == 0 && fine_operator_ != nullptr) smooth_around_coarse_correction<Scalar>(l, *fine_operator_);
+  else smooth_around_coarse_correction<Scalar>(l, data.blocks);
+}
+
+template <typename Scalar, typename Matrix>
+void MultigridPreconditioner::smooth_around_coarse_correction(std::size_t l, const Matrix& a) const {
+  const MultigridLevel& level = levels_[l];
+  const CycleData<Scalar>& data = level.data<Scalar>();
   level.smoother.smooth_from_zero(a, data.rhs, data.solution, data.work);
   residual(a, data.rhs, data.solution, data.residual);
   const CycleData<Scalar>& coarse = levels_[l + 1].data<Scalar>();

@@ -99,6 +99,14 @@ class MultigridPreconditioner final : public Preconditioner {
   /// matrix, and so does operator_of(0).
   void refresh_fine_level(const BlockSparseMatrix<double>& a);
 
+  /// From now on the fine level applies `a` without its matrix (the dynamic step's system with
+  /// new values, same topology: fem/corotated_system_operator.hpp; referenced, it must outlive
+  /// the use) and smooths with `a`'s block diagonal `inverse_diagonal`; the coarse levels, the
+  /// smoothers' eigenvalue bounds and the coarsest factorization stay, as in refresh_fine_level.
+  /// refresh_fine_level and replace_fine_level go back to the fine level's blocks.
+  void use_fine_operator(const VertexOperator& a, std::vector<Mat3> inverse_diagonal);
+  bool uses_fine_operator() const { return fine_operator_ != nullptr; }
+
   /// Replaces the fine level after cuts divided vertices (LinearSolver::update_topology): `a` is
   /// the new fine matrix (kept referenced, like the one built from), `blocks` the same as block
   /// CSR, vertex `n + i` of it a copy of the old fine vertex `origin_of_new[i]`. Each copy gets
@@ -119,10 +127,13 @@ class MultigridPreconditioner final : public Preconditioner {
   struct CoarsestSolver;
   template <typename Scalar>
   void cycle(std::size_t level) const;
+  template <typename Scalar, typename Matrix>
+  void smooth_around_coarse_correction(std::size_t level, const Matrix& a) const;
   template <typename Scalar>
   void allocate_cycle();
 
   const SparseMatrix* fine_ = nullptr;
+  const VertexOperator* fine_operator_ = nullptr;  ///< when set, the fine level's operator instead of its blocks
   std::vector<MultigridLevel> levels_;
   std::unique_ptr<CoarsestSolver> coarsest_;
   CyclePrecision precision_ = CyclePrecision::single_precision;

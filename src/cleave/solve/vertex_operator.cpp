@@ -1,0 +1,45 @@
+#include "cleave/solve/vertex_operator.hpp"
+
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+namespace cleave {
+namespace {
+
+constexpr std::size_t kVerticesPerTask = 2048;
+
+}  // namespace
+
+template <typename Scalar>
+void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) {
+  a.multiply(x, r);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, r.size(), 3 * kVerticesPerTask), [&](const tbb::blocked_range<Eigen::Index>& range) {
+    const Eigen::Index n = range.end() - range.begin();
+    r.segment(range.begin(), n) = b.segment(range.begin(), n) - r.segment(range.begin(), n);
+  });
+}
+
+template <typename Scalar>
+void jacobi_residual(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                     const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                     Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) {
+  a.multiply(x, z);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, inverse_diagonal.size(), kVerticesPerTask),
+                    [&](const tbb::blocked_range<std::size_t>& range) {
+                      for (std::size_t v = range.begin(); v < range.end(); ++v) {
+                        const auto i = static_cast<Eigen::Index>(3 * v);
+                        const Eigen::Matrix<Scalar, 3, 1> r = b.template segment<3>(i) - z.template segment<3>(i);
+                        z.template segment<3>(i) = inverse_diagonal[v] * r;
+                      }
+                    });
+}
+
+template void residual<float>(const VertexOperator&, const Eigen::VectorXf&, const Eigen::VectorXf&, Eigen::VectorXf&);
+template void residual<double>(const VertexOperator&, const Eigen::VectorXd&, const Eigen::VectorXd&, Eigen::VectorXd&);
+template void jacobi_residual<float>(const VertexOperator&, const std::vector<Mat3f>&, const Eigen::VectorXf&, const Eigen::VectorXf&,
+                                     Eigen::VectorXf&);
+template void jacobi_residual<double>(const VertexOperator&, const std::vector<Mat3>&, const Eigen::VectorXd&, const Eigen::VectorXd&,
+                                      Eigen::VectorXd&);
+
+}  // namespace cleave

@@ -1,0 +1,50 @@
+#pragma once
+// A symmetric operator on vertex dofs (3 per vertex) that is applied without storing its matrix:
+// the dynamic step's corotated system, computed cell by cell from the cells' rotations and one
+// element matrix per material (fem/corotated_system_operator.hpp). The CG and the multigrid's fine
+// level take it where they would multiply with the assembled block CSR matrix, which then need
+// not be assembled for the step: a pass reads the cells' rotations (36 B per cell in float)
+// instead of the matrix's 3x3 blocks (1.3 M blocks, 53 MB in float at 44k cells).
+//
+//   multiply(op, x, y);                 // y = A x       (float or double)
+//   residual(op, b, x, r);              // r = b - A x
+//   jacobi_residual(op, d_inv, b, x, z);  // z = D^-1 (b - A x)
+//
+// Fixed dofs follow linear_solver.hpp: identity rows and zero columns.
+#include <vector>
+
+#include "cleave/core/types.hpp"
+#include "cleave/solve/block_sparse_matrix.hpp"
+
+namespace cleave {
+
+class VertexOperator {
+ public:
+  virtual ~VertexOperator() = default;
+  virtual Eigen::Index rows() const = 0;
+  /// y = A x (y is resized); one product at a time per object (it may use work buffers).
+  virtual void multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const = 0;
+  virtual void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const = 0;
+  /// Per vertex: the inverse of A's 3x3 diagonal block (the identity where it is singular, as
+  /// inverse_diagonal_blocks of a block CSR matrix).
+  virtual std::vector<Mat3> inverse_diagonal_blocks() const = 0;
+  /// Writes A into `blocks`, which holds the block pattern the operator's topology gives
+  /// (fem/vertex_block_matrix.hpp): for a solver that must rebuild from the assembled matrix.
+  virtual void assemble(BlockSparseMatrix<double>& blocks) const = 0;
+};
+
+template <typename Scalar>
+void multiply(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) {
+  a.multiply(x, y);
+}
+
+template <typename Scalar>
+void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r);
+
+template <typename Scalar>
+void jacobi_residual(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                     const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                     Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z);
+
+}  // namespace cleave
