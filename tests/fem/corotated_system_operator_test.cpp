@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <Eigen/SparseCholesky>
 
 #include <fmt/format.h>
 
@@ -17,6 +18,7 @@
 #include "cleave/fem/stress_stiffness.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
 #include "cleave/solve/block_jacobi.hpp"
+#include "cleave/solve/multigrid_cg_solver.hpp"
 #include "fem_test_models.hpp"
 
 namespace cleave {
@@ -75,19 +77,19 @@ struct Fixture {
   }
 
   /// The system gathered into scalar CSR and eliminated as the assembled step does it.
-  SparseMatrix assembled() const {
+  SparseMatrix assembled(double c_stiff = kStiff, double c_stress = kStress, double c_mass = kMass) const {
     const LinkedVolume& volume = model.volume;
     volume.vertex_cells();
     const auto block = [&](CellId c, int a, int b) -> Mat3 {
       const auto ci = static_cast<std::size_t>(c);
       const Mat3& r = rotations[ci];
-      Mat3 m = kStiff * r * table.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
-      m.diagonal().array() += kStress * stress_stiffness_coefficient(table, tension[ci], a, b);
+      Mat3 m = c_stiff * r * table.of_label(volume.cell_label(c)).stiffness.block<3, 3>(3 * a, 3 * b) * r.transpose();
+      m.diagonal().array() += c_stress * stress_stiffness_coefficient(table, tension[ci], a, b);
       return m;
     };
     SparseMatrix a = make_vertex_block_pattern(volume);
     for (VertexId v = 0; v < volume.vertex_count(); ++v) gather_vertex_rows(volume, v, block, a);
-    for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += kMass * mass[i];
+    for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += c_mass * mass[i];
     FixedDofs held;
     held.fixed = fixed;
     held.value_mm = Vector::Zero(a.rows());
@@ -154,13 +156,11 @@ TEST(CorotatedSystemOperator, BlockDiagonalAndAssemblyEqualTheAssembledSystem) {
     largest = std::max(largest, (inverse[v] - expected.inverse_blocks[v]).norm() / norm);
   }
   EXPECT_LE(largest, 1e-12);
-  BlockSparseMatrix<double> blocks = to_block_sparse<double>(make_vertex_block_pattern(f.model.volume));
-  std::fill(blocks.values.begin(), blocks.values.end(), 7.0);  // overwritten, not added to
-  op.assemble(blocks);
+  const SparseMatrix assembled = op.assembled_matrix();
+  ASSERT_EQ(assembled.rows(), a.rows());
   const Vector x = probe(a.rows());
-  Vector y;
-  multiply(blocks, x, y);
-  EXPECT_LE((y - a * x).lpNorm<Eigen::Infinity>(), 1e-12 * (a * x).lpNorm<Eigen::Infinity>());
+  EXPECT_LE((assembled * x - a * x).lpNorm<Eigen::Infinity>(), 1e-12 * (a * x).lpNorm<Eigen::Infinity>());
+  EXPECT_EQ(assembled.nonZeros(), a.nonZeros());  // the vertex block pattern of the cut body
 }
 
 TEST(CorotatedSystemOperator, WithoutTensionItIsTheCorotatedStiffnessPlusMass) {
@@ -205,6 +205,47 @@ TEST(CorotatedSystemOperator, RefusesStateThatDoesNotFitItsTopology) {
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), fmt::format("corotated system: vector has 6 entries; expected {}", f.mass.size()));
   }
+}
+
+// A multigrid set up for one matrix and then given a very different one as an operator (turned
+// cells, 40x the stiffness, a tenth of the mass) exceeds its stale-solve budget, assembles the
+// operator and rebuilds mid-solve: the answer is still the exact one, and a later operator update
+// is taken again.
+TEST(CorotatedSystemOperator, MultigridRebuildsMidSolveFromTheOperator) {
+  const Fixture f;
+  const LinkedVolume& volume = f.model.volume;
+  MultigridOptions options;
+  options.coarsest_max_dofs = 60;  // two levels at least on this small body
+  options.stale_solve_rebuild_factor = 1e-9;  // a stale solve may take 10 iterations
+  SolveSettings settings;
+  settings.relative_tolerance = 1e-10;
+  const auto solver = make_multigrid_cg_solver(settings, options);
+  const std::vector<Mat3> unturned(f.rotations.size(), Mat3::Identity());
+  CorotatedSystemOperator first;
+  first.set_topology(volume, f.table);
+  first.set_state(unturned, {}, 1.0, 0.0, kMass, f.mass, f.fixed);
+  SparseMatrix a = first.assembled_matrix();
+  solver->setup(a, volume);
+  const Vector b = probe(a.rows());
+  Vector x = Vector::Zero(a.rows());
+  const SolveReport baseline = solver->solve(b, x);
+  ASSERT_TRUE(baseline.converged);
+  CorotatedSystemOperator second;
+  second.set_topology(volume, f.table);
+  second.set_state(f.rotations, f.tension, 40.0, 40.0, 0.1 * kMass, f.mass, f.fixed);
+  ASSERT_TRUE(solver->update_operator(second, volume));
+  x.setZero();
+  const SolveReport report = solver->solve(b, x);
+  EXPECT_TRUE(report.converged);
+  EXPECT_GT(report.iterations, 10);  // the stale budget ran out: rebuilt on the way
+  const SparseMatrix exact = f.assembled(40.0, 40.0, 0.1 * kMass);
+  const Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> direct{Eigen::SparseMatrix<double>(exact)};
+  const Vector expected = direct.solve(b);
+  EXPECT_LT((x - expected).norm(), 1e-8 * expected.norm());
+  ASSERT_TRUE(solver->update_operator(second, volume));
+  x.setZero();
+  EXPECT_TRUE(solver->solve(b, x).converged);
+  EXPECT_LT((x - expected).norm(), 1e-8 * expected.norm());
 }
 
 // The step with the operator and the step with the assembled matrix solve the same system: a

@@ -212,33 +212,29 @@ std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
   return out;
 }
 
-void CorotatedSystemOperator::assemble(BlockSparseMatrix<double>& blocks) const {
-  if (blocks.rows() != rows())
-    throw InputError(fmt::format("corotated system: the block matrix has {} rows; expected {}", blocks.rows(), rows()));
-  const VertexBlockGather gather = make_vertex_block_gather(*volume_, blocks);
-  const auto block = [&](CellId c, int a, int b) -> Mat3 {
+SparseMatrix CorotatedSystemOperator::assembled_matrix() const {
+  if (rotations_.empty() && !material_.empty()) throw InputError("corotated system: set_state must come before assembled_matrix");
+  SparseMatrix a = make_vertex_block_pattern(*volume_);
+  const auto block = [&](CellId c, int a_corner, int b_corner) -> Mat3 {
     const auto ci = static_cast<std::size_t>(c);
     const Mat3& r = rotations_[ci];
-    Mat3 m = r * twin_.stiffness[material_[ci]].block<3, 3>(3 * a, 3 * b) * r.transpose();
-    m.diagonal().array() += stress_coefficient(ci, a, b);
+    Mat3 m = r * twin_.stiffness[material_[ci]].block<3, 3>(3 * a_corner, 3 * b_corner) * r.transpose();
+    m.diagonal().array() += stress_coefficient(ci, a_corner, b_corner);
     return m;
   };
+  volume_->vertex_cells();
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, volume_->vertex_count()), [&](const tbb::blocked_range<VertexId>& r) {
-    for (VertexId v = r.begin(); v != r.end(); ++v) {
-      gather_vertex_block_row(*volume_, v, gather, block, blocks);
-      const auto row = static_cast<std::size_t>(v);
-      for (auto k = static_cast<std::size_t>(blocks.row_start[row]); k < static_cast<std::size_t>(blocks.row_start[row + 1]); ++k)
-        if (blocks.column[k] == static_cast<std::int32_t>(v))
-          for (int i = 0; i < 3; ++i) blocks.values[9 * k + static_cast<std::size_t>(4 * i)] += (*mass_kg_)[3 * static_cast<Eigen::Index>(v) + i] * c_mass_;
-    }
+    for (VertexId v = r.begin(); v != r.end(); ++v) gather_vertex_rows(*volume_, v, block, a);
   });
+  for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += c_mass_ * (*mass_kg_)[i];
   if (any_fixed_) {
     FixedDofs held;
     held.fixed = *fixed_;
     held.value_mm = Vector::Zero(rows());
     Vector unused = Vector::Zero(rows());
-    eliminate_fixed_dofs(blocks, unused, held);
+    eliminate_fixed_dofs(a, unused, held);
   }
+  return a;
 }
 
 }  // namespace cleave

@@ -39,7 +39,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   void multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const override;
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
   std::vector<Mat3> inverse_diagonal_blocks() const override;
-  void assemble(BlockSparseMatrix<double>& blocks) const override;
+  SparseMatrix assembled_matrix() const override;
 
  private:
   /// Cell values by component: for component i (x, y, z), the 8 corners' values (a SIMD register

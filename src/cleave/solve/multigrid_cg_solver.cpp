@@ -97,9 +97,13 @@ class MultigridCgSolver final : public LinearSolver {
     if (stale.converged || stale.iterations >= settings_.max_iterations) return track(stale);
     // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
     preconditioner_ = MultigridPreconditioner();
-    if (operator_ != nullptr) operator_->assemble(a_blocks_);
-    operator_ = nullptr;
-    copy_block_values(a_blocks_, a_);
+    if (operator_ != nullptr) {
+      a_ = operator_->assembled_matrix();
+      a_blocks_ = to_block_sparse<double>(a_);
+      operator_ = nullptr;
+    } else {
+      copy_block_values(a_blocks_, a_);
+    }
     build(*topology_);
     const SolveSettings rest = continuation(settings_, stale, settings_.max_iterations - stale.iterations);
     SolveReport report = solve_with(b, x, rest);

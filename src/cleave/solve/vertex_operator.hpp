@@ -28,9 +28,9 @@ class VertexOperator {
   /// Per vertex: the inverse of A's 3x3 diagonal block (the identity where it is singular, as
   /// inverse_diagonal_blocks of a block CSR matrix).
   virtual std::vector<Mat3> inverse_diagonal_blocks() const = 0;
-  /// Writes A into `blocks`, which holds the block pattern the operator's topology gives
-  /// (fem/vertex_block_matrix.hpp): for a solver that must rebuild from the assembled matrix.
-  virtual void assemble(BlockSparseMatrix<double>& blocks) const = 0;
+  /// A assembled (compressed, RowMajor; fixed dofs eliminated): for a solver that must rebuild
+  /// from the matrix.
+  virtual SparseMatrix assembled_matrix() const = 0;
 };
 
 template <typename Scalar>
