@@ -40,6 +40,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
   std::vector<Mat3> inverse_diagonal_blocks() const override;
   SparseMatrix assembled_matrix() const override;
+  const std::vector<std::uint8_t>& fixed_dofs() const override { return *fixed_; }
 
  private:
   /// Cell values by component: for component i (x, y, z), the 8 corners' values (a SIMD register

@@ -50,10 +50,29 @@ std::string_view Dynamics::solver_name() const { return solver_->name(); }
 
 void Dynamics::rebuild_topology(const CutReport* cut) {
   mass_ = lumped_mass(model_, table_);
-  // After a cut only the rows of the vertices it touched are patterned afresh.
-  system_ = cut != nullptr && system_.rows() > 0
-                ? rebuild_vertex_block_pattern(model_.volume, system_, vertices_affected_by_cut(model_.volume, *cut))
-                : make_vertex_block_pattern(model_.volume);
+  if (cut != nullptr && system_.rows() > 0) {
+    // After a cut only the rows of the vertices it touched are patterned afresh, and only when an
+    // assembly needs them (steps with the operator do not): the touched rows of all cuts since.
+    const std::vector<std::uint8_t> touched = vertices_affected_by_cut(model_.volume, *cut);
+    rows_to_pattern_.resize(touched.size(), 0);
+    for (std::size_t v = 0; v < touched.size(); ++v) rows_to_pattern_[v] |= touched[v];
+    pattern_current_ = false;
+    if (!settings_.matrix_free) ensure_pattern();
+  } else {
+    system_ = make_vertex_block_pattern(model_.volume);
+    rows_to_pattern_.clear();
+    pattern_current_ = false;
+    ensure_pattern();
+  }
+  any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
+  system_operator_.set_topology(model_.volume, table_);
+  update_rotations();
+}
+
+void Dynamics::ensure_pattern() {
+  if (pattern_current_) return;
+  if (!rows_to_pattern_.empty()) system_ = rebuild_vertex_block_pattern(model_.volume, system_, rows_to_pattern_);
+  rows_to_pattern_.clear();
   system_blocks_ = to_block_sparse<double>(system_);
   gather_ = make_vertex_block_gather(model_.volume, system_blocks_);
   diagonal_block_.assign(static_cast<std::size_t>(system_blocks_.block_rows()), 0);
@@ -63,9 +82,7 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
     diagonal_block_[static_cast<std::size_t>(v)] =
         static_cast<std::int32_t>(std::lower_bound(begin, end, static_cast<std::int32_t>(v)) - system_blocks_.column.begin());
   }
-  any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
-  system_operator_.set_topology(model_.volume, table_);
-  update_rotations();
+  pattern_current_ = true;
 }
 
 void Dynamics::update_rotations() { cell_rotations(model_.volume, u_, rotations_); }
@@ -205,10 +222,7 @@ void Dynamics::hand_system_to_solver(double c_mass) {
   // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
   // LinearSolver::update_topology) unless a divided vertex's origin is unknown.
   const VertexId vertices = model_.volume.vertex_count();
-  const bool origins_known = std::none_of(origin_of_new_.begin(), origin_of_new_.end(),
-                                          [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
-                             static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
-  const bool keep = solver_ready_ && solver_mass_factor_ == c_mass && origins_known;
+  const bool keep = solver_ready_ && solver_mass_factor_ == c_mass && origins_known();
   const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
   if (!taken_as_blocks) {
     copy_block_values(system_blocks_, system_);
@@ -226,11 +240,23 @@ void Dynamics::hand_system_to_solver(double c_mass) {
   origin_of_new_.clear();
 }
 
+bool Dynamics::origins_known() const {
+  const VertexId vertices = model_.volume.vertex_count();
+  return std::none_of(origin_of_new_.begin(), origin_of_new_.end(), [&](VertexId o) { return o < 0 || o >= solver_vertices_; }) &&
+         static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
+}
+
 bool Dynamics::hand_operator_to_solver(double c_stiff, double c_stress, double c_mass) {
-  if (!solver_ready_ || solver_mass_factor_ != c_mass || !origin_of_new_.empty() || solver_vertices_ != model_.volume.vertex_count())
-    return false;
+  if (!solver_ready_ || solver_mass_factor_ != c_mass) return false;
+  const VertexId vertices = model_.volume.vertex_count();
+  const bool cut_since = vertices != solver_vertices_ || !origin_of_new_.empty();
+  if (cut_since && !origins_known()) return false;
   system_operator_.set_state(rotations_, tension_kPa_, c_stiff, c_stress, c_mass, mass_, fixed_);
-  if (!solver_->update_operator(system_operator_, model_.volume)) return false;
+  const bool taken = cut_since ? solver_->update_topology_operator(system_operator_, model_.volume, origin_of_new_)
+                               : solver_->update_operator(system_operator_, model_.volume);
+  if (!taken) return false;
+  solver_vertices_ = vertices;
+  origin_of_new_.clear();
   ++matrix_free_steps_;
   return true;
 }
@@ -301,6 +327,7 @@ SolveReport Dynamics::step(double dt) {
     report.converged = true;
   } else {
     if (!(settings_.matrix_free && hand_operator_to_solver(c_stiff, w, c_mass))) {
+      ensure_pattern();
       assemble_system(c_stiff, w, c_mass);
       if (any_fixed_) {
         FixedDofs held;

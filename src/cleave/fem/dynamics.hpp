@@ -113,9 +113,15 @@ class Dynamics {
   double elastic_energy_uJ() const;
 
  private:
-  /// Mass, system pattern and gather table of the current topology; `cut`: the cut since the
+  /// Mass and operator topology of the current topology, and the system pattern and gather table
+  /// (at once without a cut or with matrix_free off, else at the next assembly); `cut`: the cut since the
   /// last call (its untouched rows keep their pattern), null for a fresh one.
   void rebuild_topology(const CutReport* cut = nullptr);
+  /// Makes system_, system_blocks_, gather_ and diagonal_block_ follow the current topology
+  /// (after cuts: the rows in rows_to_pattern_ afresh, the others kept).
+  void ensure_pattern();
+  /// Every vertex created since the solver's last update has a known origin among its vertices.
+  bool origins_known() const;
   /// Records, for every vertex the cut created, the vertex the solver knew it as (origin_of_new_).
   void note_vertex_origins(const CutReport& report);
   void update_rotations();
@@ -153,6 +159,10 @@ class Dynamics {
   /// only when a solver asks for it (setup, a cut, CHOLMOD).
   SparseMatrix system_;
   bool any_fixed_ = false;
+  /// The block pattern (system_, system_blocks_, gather_, diagonal_block_) is that of the current
+  /// topology; after cuts it is rebuilt only when a step assembles.
+  bool pattern_current_ = false;
+  std::vector<std::uint8_t> rows_to_pattern_;  ///< per vertex: a row the cuts since the pattern touched
   bool solver_ready_ = false;  ///< set up (later steps update values, or the topology after a cut)
   VertexId solver_vertices_ = 0;  ///< vertex count of the topology the solver last saw
   /// Per vertex created by cuts since then (id solver_vertices_ + i): the vertex it was copied

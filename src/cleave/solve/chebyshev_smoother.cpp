@@ -41,14 +41,13 @@ const std::vector<Mat3>& ChebyshevSmoother::inverse_blocks<double>() const {
   return inverse_diagonal;
 }
 
-template <typename Scalar>
-ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options) {
+namespace {
+
+/// lambda_max of D^-1 A by power iteration from a fixed, non-special start vector (deterministic),
+/// enlarged by the safety factor.
+template <typename Scalar, typename Matrix>
+double estimate_lambda_max(const Matrix& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse, const ChebyshevOptions& options) {
   using VectorS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
-  ChebyshevSmoother s;
-  s.options = options;
-  s.set_inverse_diagonal(inverse_diagonal_blocks(a));
-  const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse = s.inverse_blocks<Scalar>();
-  // Power iteration on D^-1 A from a fixed, non-special start vector (deterministic).
   const Eigen::Index n = a.rows();
   VectorS x(n), z(n);
   const VectorS zero = VectorS::Zero(n);
@@ -65,10 +64,31 @@ ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, co
   }
   const double growth = static_cast<double>(x.norm());
   if (std::isfinite(growth) && growth > estimate) estimate = growth;
-  s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+  return options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+}
+
+}  // namespace
+
+template <typename Scalar>
+ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options) {
+  ChebyshevSmoother s;
+  s.options = options;
+  s.set_inverse_diagonal(inverse_diagonal_blocks(a));
+  s.lambda_max = estimate_lambda_max<Scalar>(a, s.inverse_blocks<Scalar>(), options);
   return s;
 }
 
+template <typename Scalar>
+ChebyshevSmoother make_chebyshev_smoother(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const ChebyshevOptions& options) {
+  ChebyshevSmoother s;
+  s.options = options;
+  s.set_inverse_diagonal(std::move(inverse_diagonal));
+  s.lambda_max = estimate_lambda_max<Scalar>(a, s.inverse_blocks<Scalar>(), options);
+  return s;
+}
+
+template ChebyshevSmoother make_chebyshev_smoother<float>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&);
+template ChebyshevSmoother make_chebyshev_smoother<double>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&);
 template ChebyshevSmoother make_chebyshev_smoother<float>(const BlockSparseMatrix<float>&, const ChebyshevOptions&);
 template ChebyshevSmoother make_chebyshev_smoother<double>(const BlockSparseMatrix<double>&, const ChebyshevOptions&);
 

@@ -68,5 +68,8 @@ class ChebyshevSmoother {
 /// D^-1 and the lambda_max estimate from `a` (power iteration in a's precision).
 template <typename Scalar>
 ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options = {});
+/// The same for A applied without its matrix, with its D^-1 given; power iteration in Scalar.
+template <typename Scalar>
+ChebyshevSmoother make_chebyshev_smoother(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const ChebyshevOptions& options);
 
 }  // namespace cleave

@@ -91,6 +91,16 @@ class LinearSolver {
     (void)topology;
     return false;
   }
+  /// Like update_topology() with the new matrix applied without its values (as update_operator):
+  /// vertex n + i of `a` is a copy of vertex origin_of_new[i]. false (the default): the solver
+  /// needs the assembled matrix for this update.
+  virtual bool update_topology_operator(const VertexOperator& a, const LinkedVolume& topology,
+                                        const std::vector<VertexId>& origin_of_new) {
+    (void)a;
+    (void)topology;
+    (void)origin_of_new;
+    return false;
+  }
   /// update_topology() with the new matrix also given as block CSR (the same values, its block
   /// pattern): the multigrid then takes the blocks instead of converting `a`. The default ignores
   /// them.

@@ -30,6 +30,7 @@ class MultigridCgSolver final : public LinearSolver {
     operator_ = nullptr;
     a_ = a;
     a_.makeCompressed();
+    rows_ = a_.rows();
     a_blocks_ = to_block_sparse<double>(a_);
     build(topology);
   }
@@ -63,11 +64,27 @@ class MultigridCgSolver final : public LinearSolver {
   }
 
   bool update_operator(const VertexOperator& a, const LinkedVolume& topology) override {
-    if (rebuild_requested_ || stale_updates_ >= options_.max_stale_updates || a.rows() != a_.rows() ||
+    if (rebuild_requested_ || stale_updates_ >= options_.max_stale_updates || a.rows() != rows_ ||
         preconditioner_.levels().size() < 2)
       return false;
     preconditioner_.use_fine_operator(a, a.inverse_diagonal_blocks());
     operator_ = &a;
+    ++stale_updates_;
+    topology_ = &topology;
+    return true;
+  }
+
+  bool update_topology_operator(const VertexOperator& a, const LinkedVolume& topology,
+                                const std::vector<VertexId>& origin_of_new) override {
+    if (rebuild_requested_ || stale_updates_ >= options_.max_stale_updates || preconditioner_.levels().size() < 2 ||
+        a.rows() != rows_ + 3 * static_cast<Eigen::Index>(origin_of_new.size()))
+      return false;
+    preconditioner_.replace_fine_level(a, a.inverse_diagonal_blocks(), origin_of_new, options_.smoother);
+    operator_ = &a;
+    rows_ = a.rows();
+    // The matrices of the old topology are of no further use: a rebuild assembles the operator.
+    a_ = SparseMatrix();
+    a_blocks_ = BlockSparseMatrix<double>();
     ++stale_updates_;
     topology_ = &topology;
     return true;
@@ -85,8 +102,8 @@ class MultigridCgSolver final : public LinearSolver {
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
-    if (b.size() != a_.rows())
-      throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), a_.rows()));
+    if (b.size() != rows_)
+      throw InputError(fmt::format("multigrid: right-hand side has {} entries; the matrix set up has {} rows", b.size(), rows_));
     if (stale_updates_ == 0 || baseline_iterations_ < 0 || options_.stale_solve_rebuild_factor <= 0 || topology_ == nullptr)
       return track(solve_with(b, x, settings_));
     SolveSettings capped = settings_;
@@ -128,13 +145,14 @@ class MultigridCgSolver final : public LinearSolver {
   /// when the levels cannot be kept). `blocks`: a's block copy when the caller has one.
   void replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>* blocks, const LinkedVolume& topology,
                           const std::vector<VertexId>& origin_of_new) {
-    const Eigen::Index expected_rows = a_.rows() + 3 * static_cast<Eigen::Index>(origin_of_new.size());
+    const Eigen::Index expected_rows = rows_ + 3 * static_cast<Eigen::Index>(origin_of_new.size());
     if (preconditioner_.levels().size() < 2 || a.rows() != expected_rows || !a.isCompressed() || rebuild_requested_ ||
         stale_updates_ >= options_.max_stale_updates) {
       setup(a, topology);
       return;
     }
     a_ = a;
+    rows_ = a_.rows();
     operator_ = nullptr;
     a_blocks_ = blocks != nullptr ? *blocks : to_block_sparse<double>(a_);
     preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
@@ -186,6 +204,7 @@ class MultigridCgSolver final : public LinearSolver {
   SparseMatrix a_;                      ///< the matrix of the last setup (the levels' source)
   BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the CG multiplies with ...
   const VertexOperator* operator_ = nullptr;  ///< ... unless the last update gave the matrix as an operator
+  Eigen::Index rows_ = 0;  ///< of the current matrix (a_ is empty after a topology update by operator)
   MultigridPreconditioner preconditioner_;
   int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
   int baseline_iterations_ = -1;  ///< iterations of the first solve after the build

@@ -217,21 +217,20 @@ void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>
   round_to_single(a.values, fine.single.blocks.values);
 }
 
-void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
-                                                 const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
+void MultigridPreconditioner::extend_fine_prolongation(const std::vector<VertexId>& origin_of_new, Eigen::Index new_rows) {
   if (levels_.size() < 2) throw InputError("multigrid: a single-level hierarchy has no fine level to replace; set it up afresh");
-  MultigridLevel& fine = levels_[0];
-  Prolongation& p = fine.from_coarser;
+  Prolongation& p = levels_[0].from_coarser;
   const VertexId old_count = p.fine_count();
   const auto copies = static_cast<VertexId>(origin_of_new.size());
-  if (a.rows() != 3 * static_cast<Eigen::Index>(old_count + copies) || blocks.rows() != a.rows())
+  if (new_rows != 3 * static_cast<Eigen::Index>(old_count + copies))
     throw InputError(fmt::format("multigrid: the new fine matrix has {} rows; expected {} ({} vertices and {} copies, 3 dofs each)",
-                                 a.rows(), 3 * (old_count + copies), old_count, copies));
-  p.by_fine.reserve(p.by_fine.size() + 8 * origin_of_new.size());
-  for (const VertexId origin : origin_of_new) {
+                                 new_rows, 3 * (old_count + copies), old_count, copies));
+  for (const VertexId origin : origin_of_new)
     if (origin < 0 || origin >= old_count)
       throw InputError(fmt::format("multigrid: a divided vertex's origin is {}; expected a vertex of the old fine level (0 to {})",
                                    origin, old_count - 1));
+  p.by_fine.reserve(p.by_fine.size() + 8 * origin_of_new.size());
+  for (const VertexId origin : origin_of_new) {
     for (int k = p.fine_start[static_cast<std::size_t>(origin)]; k < p.fine_start[static_cast<std::size_t>(origin) + 1]; ++k) {
       const Prolongation::Entry entry = p.by_fine[static_cast<std::size_t>(k)];
       p.by_fine.push_back(entry);
@@ -239,6 +238,34 @@ void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const Bl
     p.fine_start.push_back(static_cast<int>(p.by_fine.size()));
   }
   transpose_prolongation(p);
+}
+
+void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::vector<Mat3> inverse_diagonal,
+                                                 const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
+  extend_fine_prolongation(origin_of_new, a.rows());
+  if (inverse_diagonal.size() != static_cast<std::size_t>(a.rows() / 3) || a.fixed_dofs().size() != static_cast<std::size_t>(a.rows()))
+    throw InputError(fmt::format("multigrid: the new fine operator has {} rows, {} diagonal blocks and {} fixed flags",
+                                 a.rows(), inverse_diagonal.size(), a.fixed_dofs().size()));
+  MultigridLevel& fine = levels_[0];
+  fine_operator_ = &a;
+  fine.fixed = a.fixed_dofs();
+  fine.single.blocks = BlockSparseMatrix<float>();  // the old pattern: of no use to the new level
+  fine.twin.blocks = BlockSparseMatrix<double>();
+  if (precision_ == CyclePrecision::single_precision) {
+    fine.smoother = make_chebyshev_smoother<float>(a, std::move(inverse_diagonal), smoother);
+    allocate_cycle<float>();
+  } else {
+    fine.smoother = make_chebyshev_smoother<double>(a, std::move(inverse_diagonal), smoother);
+    allocate_cycle<double>();
+  }
+}
+
+void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
+                                                 const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
+  extend_fine_prolongation(origin_of_new, a.rows());
+  if (blocks.rows() != a.rows())
+    throw InputError(fmt::format("multigrid: the block copy of the new fine matrix has {} rows; the matrix has {}", blocks.rows(), a.rows()));
+  MultigridLevel& fine = levels_[0];
   fine_ = &a;
   fine_operator_ = nullptr;
   fine.fixed = identity_rows(a);

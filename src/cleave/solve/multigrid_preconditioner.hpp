@@ -116,6 +116,14 @@ class MultigridPreconditioner final : public Preconditioner {
   void replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
                           const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother);
 
+  /// replace_fine_level for the new fine matrix applied without its values (the dynamic step's
+  /// system after a cut): the fine level applies `a` (referenced, it must outlive the use) with
+  /// its D^-1 `inverse_diagonal` and fixed dofs, its eigenvalue bound by power iteration on `a`;
+  /// the coarse levels and the coarsest factorization stay. operator_of(0) is then no longer the
+  /// fine matrix (a rebuild sets up afresh). Throws InputError as replace_fine_level.
+  void replace_fine_level(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const std::vector<VertexId>& origin_of_new,
+                          const ChebyshevOptions& smoother);
+
   /// Level 0 is the fine level; the last level is solved directly.
   const std::vector<MultigridLevel>& levels() const { return levels_; }
   /// The operator of a level (level 0: the referenced fine matrix).
@@ -131,6 +139,9 @@ class MultigridPreconditioner final : public Preconditioner {
   void smooth_around_coarse_correction(std::size_t level, const Matrix& a) const;
   template <typename Scalar>
   void allocate_cycle();
+  /// Gives the fine vertices n + i the prolongation rows of their origins origin_of_new[i]
+  /// (`new_rows`: the new fine level's row count, for the check).
+  void extend_fine_prolongation(const std::vector<VertexId>& origin_of_new, Eigen::Index new_rows);
 
   const SparseMatrix* fine_ = nullptr;
   const VertexOperator* fine_operator_ = nullptr;  ///< when set, the fine level's operator instead of its blocks

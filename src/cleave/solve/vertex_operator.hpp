@@ -11,6 +11,7 @@
 //   jacobi_residual(op, d_inv, b, x, z);  // z = D^-1 (b - A x)
 //
 // Fixed dofs follow linear_solver.hpp: identity rows and zero columns.
+#include <cstdint>
 #include <vector>
 
 #include "cleave/core/types.hpp"
@@ -31,6 +32,8 @@ class VertexOperator {
   /// A assembled (compressed, RowMajor; fixed dofs eliminated): for a solver that must rebuild
   /// from the matrix.
   virtual SparseMatrix assembled_matrix() const = 0;
+  /// Per dof: 1 where A has an identity row (a fixed dof).
+  virtual const std::vector<std::uint8_t>& fixed_dofs() const = 0;
 };
 
 template <typename Scalar>
