@@ -19,6 +19,7 @@
 #include "cleave/fem/vertex_block_matrix.hpp"
 #include "cleave/solve/block_jacobi.hpp"
 #include "cleave/solve/multigrid_cg_solver.hpp"
+#include "cleave/solve/multigrid_preconditioner.hpp"
 #include "fem_test_models.hpp"
 
 namespace cleave {
@@ -204,6 +205,76 @@ TEST(CorotatedSystemOperator, RefusesStateThatDoesNotFitItsTopology) {
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), fmt::format("corotated system: vector has 6 entries; expected {}", f.mass.size()));
+  }
+}
+
+/// Largest relative difference of two preconditioned vectors.
+double relative_difference(const Vector& a, const Vector& b) { return (a - b).norm() / b.norm(); }
+
+// The V-cycle whose fine level applies the operator is the V-cycle on the assembled blocks: in
+// float (to its rounding), after the switch to double (to 1e-12), and after a cut replaced the fine
+// level from the operator instead of from the new matrix.
+TEST(CorotatedSystemOperator, MultigridCycleOnTheOperatorIsTheCycleOnTheBlocks) {
+  Fixture f;
+  MultigridOptions options;
+  options.coarsest_max_dofs = 60;
+  const SparseMatrix a = f.assembled();
+  const CorotatedSystemOperator op = f.op();
+  MultigridPreconditioner on_blocks = build_multigrid(a, f.model.volume, options);
+  MultigridPreconditioner on_operator = build_multigrid(a, f.model.volume, options);
+  ASSERT_GE(on_operator.levels().size(), 2u);
+  on_operator.use_fine_operator(op, op.inverse_diagonal_blocks());
+  EXPECT_TRUE(on_operator.uses_fine_operator());
+  const Vector r = probe(a.rows());
+  Vector z_blocks, z_operator;
+  on_blocks.apply(r, z_blocks);
+  on_operator.apply(r, z_operator);
+  EXPECT_LT(relative_difference(z_operator, z_blocks), 1e-5);
+  const BlockSparseMatrix<double> blocks = to_block_sparse<double>(a);
+  on_blocks.use_double_precision(blocks);
+  on_operator.use_double_precision(blocks);
+  on_blocks.apply(r, z_blocks);
+  on_operator.apply(r, z_operator);
+  EXPECT_LT(relative_difference(z_operator, z_blocks), 1e-12);
+
+  // A cut through the body's other half: both hierarchies keep their coarse levels.
+  const VertexId before = f.model.volume.vertex_count();
+  const CutReport report = f.model.volume.cut_links(test::faces_between(f.model.volume, [&](CellId c) {
+    const Vec3i v = f.model.volume.cell_voxel(c);
+    return v.x() >= 4 && v.y() >= 2 && v.y() < 4;
+  }));
+  const VertexId after = f.model.volume.vertex_count();
+  ASSERT_GT(after, before);
+  std::vector<VertexId> origins(static_cast<std::size_t>(after - before), kNone);
+  for (const VertexSplit& split : report.splits)
+    for (const VertexId v : split.created) origins[static_cast<std::size_t>(v - before)] = split.original;
+  Fixture cut_state;  // the same construction on the cut topology (rotations, tension, mass, fixed)
+  cut_state.model = f.model;
+  cut_state.table = make_element_table(cut_state.model);
+  cut_state.mass = lumped_mass(cut_state.model, cut_state.table);
+  cut_state.fixed = held_dofs(cut_state.model.volume);
+  std::vector<Vec6> residual(static_cast<std::size_t>(cut_state.model.volume.cell_count()), Vec6::Constant(3.0));
+  cell_rotations_and_tension(cut_state.model.volume, cut_state.table, residual, turned_displacement(cut_state.model.volume),
+                             cut_state.rotations, cut_state.tension);
+  const SparseMatrix a_cut = cut_state.assembled();
+  const CorotatedSystemOperator op_cut = cut_state.op();
+  on_blocks.replace_fine_level(a_cut, to_block_sparse<double>(a_cut), origins, options.smoother);
+  on_operator.replace_fine_level(op_cut, op_cut.inverse_diagonal_blocks(), origins, options.smoother);
+  EXPECT_EQ(on_operator.levels()[0].fixed, cut_state.fixed);
+  EXPECT_NEAR(on_operator.levels()[0].smoother.lambda_max, on_blocks.levels()[0].smoother.lambda_max,
+              1e-10 * on_blocks.levels()[0].smoother.lambda_max);
+  const Vector r_cut = probe(a_cut.rows());
+  on_blocks.apply(r_cut, z_blocks);
+  on_operator.apply(r_cut, z_operator);
+  EXPECT_LT(relative_difference(z_operator, z_blocks), 1e-12);
+  // Sizes that do not fit are refused, naming them.
+  try {
+    on_operator.replace_fine_level(op_cut, op_cut.inverse_diagonal_blocks(), origins, options.smoother);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("multigrid: the new fine matrix has {} rows; expected {} ({} vertices and {} copies, 3 "
+                                                 "dofs each)",
+                                                 a_cut.rows(), 3 * (after + static_cast<VertexId>(origins.size())), after, origins.size()));
   }
 }
 
