@@ -17,10 +17,13 @@
 // unrotated (reference) frame and rotated into the world: the residual stress tensor is attached
 // to the material and turns with it. The step linearizes f_int at the current state with R fixed
 // (stiffness K_R = sum R K^e R^T) and solves one linear system per step with the chosen solver,
-// warm-started from the Newmark predictor of the previous state. K_R is re-gathered in place, as
-// block CSR, on a pattern kept until the topology changes, and the solver is only told the new
-// values (LinearSolver::update_block_values / update_values: the multigrid keeps its levels,
-// CHOLMOD its analysis).
+// warm-started from the Newmark predictor of the previous state. The multigrid takes the system
+// as an operator applied cell by cell (fem/corotated_system_operator.hpp; after cuts too), so a
+// step assembles nothing between the multigrid's rebuilds. Where a matrix is needed (a rebuild,
+// CHOLMOD, Eigen's CG, matrix_free off), K_R is re-gathered in place, as block CSR, on a pattern
+// patched for the rows cuts touched, and the solver is only told the new values
+// (LinearSolver::update_block_values / update_values: the multigrid keeps its levels, CHOLMOD
+// its analysis).
 //
 //   Dynamics sim(model, stress_kPa, settings);   // model must outlive sim
 //   for (int i = 0; i < n; ++i) sim.step(1e-3);
