@@ -32,15 +32,8 @@ TissueModel cut_two_material_box() {
 
 /// Per cell, the rotation of a turned and wobbled state (not the identity anywhere).
 std::vector<Mat3> turned_rotations(const LinkedVolume& volume) {
-  const Mat3 turn = Eigen::AngleAxisd(0.9, Vec3(0.3, -1.0, 0.5).normalized()).toRotationMatrix();
-  Vector u(3 * static_cast<Eigen::Index>(volume.vertex_count()));
-  for (VertexId i = 0; i < volume.vertex_count(); ++i) {
-    const Vec3 x = volume.vertex_position_mm(i);
-    const Vec3 wobble(0.06 * std::sin(1.1 * x.y()), 0.05 * std::cos(0.8 * x.x()), 0.04 * std::sin(x.x() + x.z()));
-    u.segment<3>(3 * i) = turn * (x + wobble) - x;
-  }
   std::vector<Mat3> rotations;
-  cell_rotations(volume, u, rotations);
+  cell_rotations(volume, test::turned_displacement(volume), rotations);
   return rotations;
 }
 

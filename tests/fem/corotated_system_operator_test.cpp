@@ -38,18 +38,6 @@ TissueModel cut_two_material_box() {
   return model;
 }
 
-/// A turned and wobbled displacement (no cell keeps the identity rotation).
-Vector turned_displacement(const LinkedVolume& volume) {
-  const Mat3 turn = Eigen::AngleAxisd(0.9, Vec3(0.3, -1.0, 0.5).normalized()).toRotationMatrix();
-  Vector u(3 * static_cast<Eigen::Index>(volume.vertex_count()));
-  for (VertexId i = 0; i < volume.vertex_count(); ++i) {
-    const Vec3 x = volume.vertex_position_mm(i);
-    const Vec3 wobble(0.06 * std::sin(1.1 * x.y()), 0.05 * std::cos(0.8 * x.x()), 0.04 * std::sin(x.x() + x.z()));
-    u.segment<3>(3 * i) = turn * (x + wobble) - x;
-  }
-  return u;
-}
-
 /// Whole vertices held, and single axes of others.
 std::vector<std::uint8_t> held_dofs(const LinkedVolume& volume) {
   std::vector<std::uint8_t> fixed(3 * static_cast<std::size_t>(volume.vertex_count()), 0);
@@ -72,7 +60,7 @@ struct Fixture {
     for (std::size_t c = 0; c < residual.size(); ++c) {
       residual[c] << 20.0 + static_cast<double>(c % 5), 8.0, -3.0 * static_cast<double>(c % 2), 2.0, 0.5, -1.0;
     }
-    cell_rotations_and_tension(model.volume, table, residual, turned_displacement(model.volume), rotations, tension);
+    cell_rotations_and_tension(model.volume, table, residual, test::turned_displacement(model.volume), rotations, tension);
     mass = lumped_mass(model, table);
     fixed = held_dofs(model.volume);
   }
@@ -254,7 +242,7 @@ TEST(CorotatedSystemOperator, MultigridCycleOnTheOperatorIsTheCycleOnTheBlocks) 
   cut_state.mass = lumped_mass(cut_state.model, cut_state.table);
   cut_state.fixed = held_dofs(cut_state.model.volume);
   std::vector<Vec6> residual(static_cast<std::size_t>(cut_state.model.volume.cell_count()), Vec6::Constant(3.0));
-  cell_rotations_and_tension(cut_state.model.volume, cut_state.table, residual, turned_displacement(cut_state.model.volume),
+  cell_rotations_and_tension(cut_state.model.volume, cut_state.table, residual, test::turned_displacement(cut_state.model.volume),
                              cut_state.rotations, cut_state.tension);
   const SparseMatrix a_cut = cut_state.assembled();
   const CorotatedSystemOperator op_cut = cut_state.op();
@@ -328,20 +316,12 @@ TEST(CorotatedSystemOperator, DynamicsStepsWithItFollowTheAssembledSteps) {
   const std::vector<Vec6> field(static_cast<std::size_t>(uncut.volume.cell_count()), stress);
   const auto run = [&](bool matrix_free, int& operator_steps) {
     TissueModel model = uncut;
-    DynamicsSettings settings;
+    DynamicsSettings settings = test::held_plate_settings(model.volume);
     settings.matrix_free = matrix_free;
-    settings.solve.relative_tolerance = 1e-11;
-    settings.step_tolerance = 0;
-    settings.mass_damping_per_s = 50.0;
-    for (VertexId v = 0; v < model.volume.vertex_count(); ++v)
-      if (model.volume.vertex_position_mm(v).x() < 1e-9) settings.fixed_vertices.push_back(v);
     Dynamics sim(model, field, settings);
     for (int i = 0; i < 3; ++i) sim.step(1e-3);
     for (const int depth : {5, 9}) {
-      sim.topology_changed(model.volume.cut_links(test::faces_between(model.volume, [&](CellId c) {
-        const Vec3i& v = model.volume.cell_voxel(c);
-        return v.x() < 12 && v.y() < depth;
-      })));
+      sim.topology_changed(test::cut_plate_slit(model, depth));
       for (int i = 0; i < 4; ++i) sim.step(1e-3);
     }
     // A third cut, then past the multigrid's 64 stale updates: the rebuild assembles on the block

@@ -165,20 +165,10 @@ TEST(Dynamics, CutsMidSimulationWithTheKeptMultigridLevelsFollowTheExactSolve) {
   const std::vector<Vec6> field(static_cast<std::size_t>(uncut.volume.cell_count()), stress);
   const auto run = [&](SolverKind solver) {
     TissueModel model = uncut;
-    DynamicsSettings settings;
-    settings.solver = solver;
-    settings.solve.relative_tolerance = 1e-11;
-    settings.step_tolerance = 0;
-    settings.mass_damping_per_s = 50.0;
-    for (VertexId v = 0; v < model.volume.vertex_count(); ++v)
-      if (model.volume.vertex_position_mm(v).x() < 1e-9) settings.fixed_vertices.push_back(v);
-    Dynamics sim(model, field, settings);
+    Dynamics sim(model, field, test::held_plate_settings(model.volume, solver));
     for (int i = 0; i < 3; ++i) sim.step(kTimeStep_s);
     for (const int depth : {5, 9}) {  // a slit across the middle, then deeper
-      sim.topology_changed(model.volume.cut_links(test::faces_between(model.volume, [&](CellId c) {
-        const Vec3i& v = model.volume.cell_voxel(c);
-        return v.x() < 12 && v.y() < depth;
-      })));
+      sim.topology_changed(test::cut_plate_slit(model, depth));
       for (int i = 0; i < 4; ++i) sim.step(kTimeStep_s);
     }
     return sim.displacement();

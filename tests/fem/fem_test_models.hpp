@@ -2,6 +2,9 @@
 // Small models for the fem tests: boxes of cubic cells built straight from a label volume.
 #include <map>
 
+#include <Eigen/Geometry>
+
+#include "cleave/fem/dynamics.hpp"
 #include "cleave/model/tissue_model.hpp"
 
 namespace cleave::test {
@@ -42,6 +45,39 @@ std::vector<CellFace> faces_between(const LinkedVolume& volume, Inside&& inside)
     }
   }
   return faces;
+}
+
+/// A turned (0.9 rad about an oblique axis) and wobbled state: no cell keeps the identity rotation.
+inline Vector turned_displacement(const LinkedVolume& volume) {
+  const Mat3 turn = Eigen::AngleAxisd(0.9, Vec3(0.3, -1.0, 0.5).normalized()).toRotationMatrix();
+  Vector u(3 * static_cast<Eigen::Index>(volume.vertex_count()));
+  for (VertexId i = 0; i < volume.vertex_count(); ++i) {
+    const Vec3 x = volume.vertex_position_mm(i);
+    const Vec3 wobble(0.06 * std::sin(1.1 * x.y()), 0.05 * std::cos(0.8 * x.x()), 0.04 * std::sin(x.x() + x.z()));
+    u.segment<3>(3 * i) = turn * (x + wobble) - x;
+  }
+  return u;
+}
+
+/// The stressed plate of the cut-mid-simulation tests (24 x 12 x 3 cells of 1 mm) is held at
+/// x = 0, damped (50 / s) and solved tightly (1e-11, no step tolerance), with `solver`.
+inline DynamicsSettings held_plate_settings(const LinkedVolume& volume, SolverKind solver = SolverKind::multigrid_cg) {
+  DynamicsSettings settings;
+  settings.solver = solver;
+  settings.solve.relative_tolerance = 1e-11;
+  settings.step_tolerance = 0;
+  settings.mass_damping_per_s = 50.0;
+  for (VertexId v = 0; v < volume.vertex_count(); ++v)
+    if (volume.vertex_position_mm(v).x() < 1e-9) settings.fixed_vertices.push_back(v);
+  return settings;
+}
+
+/// Cuts the plate's slit across its middle (cells x < 12) down to y < depth.
+inline CutReport cut_plate_slit(TissueModel& model, int depth) {
+  return model.volume.cut_links(faces_between(model.volume, [&](CellId c) {
+    const Vec3i& v = model.volume.cell_voxel(c);
+    return v.x() < 12 && v.y() < depth;
+  }));
 }
 
 }  // namespace cleave::test
