@@ -12,8 +12,6 @@
 #include "cleave/fem/solve_static.hpp"
 #include "cleave/fem/stress_stiffness.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
-#include "cleave/solve/multigrid_cg_solver.hpp"
-#include "cleave/solve/multigrid_preconditioner.hpp"
 
 namespace cleave {
 
@@ -36,17 +34,7 @@ Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_k
     throw InputError(fmt::format("step tolerance is {}; expected a number from 0 to below 1", settings_.step_tolerance));
   SolveSettings step_solve = settings_.solve;
   step_solve.initial_residual_tolerance = settings_.step_tolerance;
-  if (settings_.solver == SolverKind::multigrid_cg) {
-    // The step's iterations are cheap with the operator (~15 ms at 44k cells) and a rebuild of
-    // the levels costs ~450 ms more than a step: let the iterations grow to twice their first
-    // before rebuilding (on the 44k tube under a sideways load and a cut, 24 steps took 7.4-7.8 s
-    // instead of 8.4-9.1 s with the statics' 1.3).
-    MultigridOptions options;
-    options.stale_iteration_growth = kStepStaleIterationGrowth;
-    solver_ = make_multigrid_cg_solver(step_solve, options);
-  } else {
-    solver_ = make_linear_solver(settings_.solver, step_solve);
-  }
+  solver_ = make_linear_solver(settings_.solver, step_solve);
   const FixedDofs held = fix_vertices(volume.vertex_count(), settings_.fixed_vertices);
   fixed_ = held.fixed;
   u_ = Vector::Zero(dofs);

@@ -47,9 +47,6 @@
 namespace cleave {
 
 inline constexpr double kNewmarkGamma = 0.5;  ///< average acceleration; plus numerical_damping
-/// The step's multigrid rebuilds its levels once a solve needs more than this factor (plus 2)
-/// times the iterations of the first solve after the last rebuild (MultigridOptions).
-inline constexpr double kStepStaleIterationGrowth = 2.0;
 /// A displacement this many times the model's bounding-box diagonal means the motion diverged.
 inline constexpr double kDivergedSizes = 1000.0;
 
