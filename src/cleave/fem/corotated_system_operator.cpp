@@ -53,8 +53,6 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   with_tension_ = !tension_kPa.empty();
   fixed_ = &fixed;
   any_fixed_ = std::any_of(fixed.begin(), fixed.end(), [](std::uint8_t f) { return f != 0; });
-  c_stiff_ = c_stiff;
-  c_stress_ = c_stress;
   c_mass_ = c_mass;
   mass_kg_ = &mass_kg;
   const std::size_t materials = table_->per_material.size();

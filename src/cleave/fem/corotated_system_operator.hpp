@@ -3,9 +3,9 @@
 //   A = c_stiff sum_c R_c K^e R_c^T + c_stress sum_c K_sigma,c + c_mass M,
 // fixed dofs as identity rows and zero columns: the matrix Dynamics assembles (fem/dynamics.hpp)
 // and eliminates. A product is two parallel passes: per cell, its 24 values
-// R [c_stiff K^e + c_stress (sum_k t_k G_k) (x) I_3] R^T x_e (K^e and G_k per material, in the
-// cache; R and the tension t per cell); then per vertex, the sum over its cells plus the mass
-// term. It streams the cells' rotations, tension and corners and a 24-value buffer per cell
+// R [c_stiff K^e + c_stress (sum_k t_k G_k) (x) I_3] R^T x_e (K^e per material and the six G_k
+// in the cache; R and the tension t per cell); then per vertex, the sum over its cells plus the
+// mass term. It streams the cells' rotations, tension and corners and a 24-value buffer per cell
 // (about 12 MB at 44k cells in float) instead of the assembled blocks (53 MB in float, 106 MB in
 // double), and a step no longer assembles the blocks at all.
 //
@@ -14,7 +14,10 @@
 //   op.set_state(rotations, tension, c_k, c_s, c_m, mass, fixed);   // every step
 //   multiply(op, x, y);                              // float or double
 //
-// The volume, table, rotations and tension are referenced and must outlive the products.
+// The volume, table, rotations, tension, mass and fixed flags are referenced and must outlive the
+// products.
+#include <array>
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -30,8 +33,9 @@ class CorotatedSystemOperator final : public VertexOperator {
   /// corner in each).
   void set_topology(const LinkedVolume& volume, const ElementTable& table);
   /// The step's state: `rotations` per cell, `tension_kPa` per cell or empty (no stress
-  /// stiffness), the coefficients (c_stiff 1, c_stress 1 mN/mm per kPa and mm, c_mass 1/s^2),
-  /// `mass_kg` and `fixed` per dof. Throws InputError for sizes that do not fit the topology.
+  /// stiffness), the coefficients c_stiff and c_stress (dimensionless) and c_mass (1/s^2),
+  /// `mass_kg` and `fixed` per dof (referenced, like the rotations and tension). Throws
+  /// InputError for sizes that do not fit the topology.
   void set_state(std::span<const Mat3> rotations, std::span<const Vec6> tension_kPa, double c_stiff, double c_stress,
                  double c_mass, const Vector& mass_kg, const std::vector<std::uint8_t>& fixed);
 
@@ -78,7 +82,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   bool with_tension_ = false;
   bool any_fixed_ = false;
   const std::vector<std::uint8_t>* fixed_ = nullptr;
-  double c_stiff_ = 0, c_stress_ = 0, c_mass_ = 0;
+  double c_mass_ = 0;  ///< c_stiff and c_stress are folded into stiffness and tension
   const Vector* mass_kg_ = nullptr;
   Precision<float> single_;
   Precision<double> twin_;
