@@ -242,10 +242,10 @@ void MultigridPreconditioner::extend_fine_prolongation(const std::vector<VertexI
 
 void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::vector<Mat3> inverse_diagonal,
                                                  const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
-  extend_fine_prolongation(origin_of_new, a.rows());
   if (inverse_diagonal.size() != static_cast<std::size_t>(a.rows() / 3) || a.fixed_dofs().size() != static_cast<std::size_t>(a.rows()))
     throw InputError(fmt::format("multigrid: the new fine operator has {} rows, {} diagonal blocks and {} fixed flags",
                                  a.rows(), inverse_diagonal.size(), a.fixed_dofs().size()));
+  extend_fine_prolongation(origin_of_new, a.rows());
   MultigridLevel& fine = levels_[0];
   fine_operator_ = &a;
   fine.fixed = a.fixed_dofs();
@@ -262,9 +262,9 @@ void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::v
 
 void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
                                                  const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
-  extend_fine_prolongation(origin_of_new, a.rows());
   if (blocks.rows() != a.rows())
     throw InputError(fmt::format("multigrid: the block copy of the new fine matrix has {} rows; the matrix has {}", blocks.rows(), a.rows()));
+  extend_fine_prolongation(origin_of_new, a.rows());
   MultigridLevel& fine = levels_[0];
   fine_ = &a;
   fine_operator_ = nullptr;

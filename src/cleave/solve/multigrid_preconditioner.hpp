@@ -140,7 +140,8 @@ class MultigridPreconditioner final : public Preconditioner {
   template <typename Scalar>
   void allocate_cycle();
   /// Gives the fine vertices n + i the prolongation rows of their origins origin_of_new[i]
-  /// (`new_rows`: the new fine level's row count, for the check).
+  /// (`new_rows`: the new fine level's row count, for the check). Checks everything before it
+  /// changes anything: on InputError the levels are as they were.
   void extend_fine_prolongation(const std::vector<VertexId>& origin_of_new, Eigen::Index new_rows);
 
   const SparseMatrix* fine_ = nullptr;
