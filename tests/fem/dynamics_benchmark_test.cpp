@@ -1,5 +1,6 @@
 // Dynamic step timings on the paper's 44,000-cell tube (Table 1), held at one end, under a
-// sideways load. A benchmark, not a test: DISABLED_ so that it runs only on request:
+// sideways load, and the step system's products. Benchmarks, not tests: DISABLED_ so that they
+// run only on request:
 //   cleave_test_fem --gtest_also_run_disabled_tests --gtest_filter='*DynamicsBenchmark*'
 // Environment: CLEAVE_BENCH_SOLVER (multigrid, eigen-cg, cholmod; default multigrid),
 // CLEAVE_BENCH_STEPS (default 20), CLEAVE_BENCH_STEP_TOLERANCE (DynamicsSettings::step_tolerance),
@@ -17,13 +18,71 @@
 #include <cstdlib>
 #include <string>
 
+#include "cleave/fem/corotated_system_operator.hpp"
+#include "cleave/fem/corotation.hpp"
 #include "cleave/fem/dynamics.hpp"
+#include "cleave/fem/lumped_mass.hpp"
+#include "cleave/fem/stress_stiffness.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
 
 namespace cleave {
 namespace {
 
 using Clock = std::chrono::steady_clock;
+
+/// Median wall time (ms) of 31 calls.
+template <typename Work>
+double median_ms(Work&& work) {
+  std::vector<double> ms;
+  for (int i = 0; i < 31; ++i) {
+    const auto t = Clock::now();
+    work();
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// The step's system on the 44k tube (2 kPa tension in every cell, a small smooth displacement):
+// one product cell by cell (CorotatedSystemOperator) against the same matrix assembled as block
+// CSR, in float and double, and the operator's block diagonal. Three rounds; prints only.
+TEST(DynamicsBenchmark, DISABLED_Tube44kSystemProducts) {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(42, 42, 51);
+  Material m;
+  m.youngs_modulus_kPa = 3.0;
+  m.poisson_ratio = 0.45;
+  const TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+  const LinkedVolume& volume = model.volume;
+  const ElementTable table = make_element_table(model);
+  Vector u(3 * static_cast<Eigen::Index>(volume.vertex_count()));
+  for (Eigen::Index i = 0; i < u.size(); ++i) u[i] = 0.05 * std::sin(0.001 * static_cast<double>(i));
+  Vec6 tension = Vec6::Zero();
+  tension[0] = tension[1] = 2.0;
+  const std::vector<Vec6> residual(static_cast<std::size_t>(volume.cell_count()), tension);
+  std::vector<Mat3> rotations;
+  std::vector<Vec6> tensions;
+  cell_rotations_and_tension(volume, table, residual, u, rotations, tensions);
+  const Vector mass = lumped_mass(model, table);
+  const std::vector<std::uint8_t> fixed(static_cast<std::size_t>(u.size()), 0);
+  CorotatedSystemOperator op;
+  op.set_topology(volume, table);
+  op.set_state(rotations, tensions, 0.8, 0.8, 3600.0, mass, fixed);
+  const BlockSparseMatrix<double> blocks = to_block_sparse<double>(op.assembled_matrix());
+  BlockSparseMatrix<float> single;
+  single.row_start = blocks.row_start;
+  single.column = blocks.column;
+  single.values.assign(blocks.values.begin(), blocks.values.end());
+  const Eigen::VectorXf x_single = u.cast<float>();
+  Eigen::VectorXf y_single;
+  Vector y;
+  std::printf("%d cells, %d vertices, %zu blocks\n", volume.cell_count(), volume.vertex_count(), blocks.blocks());
+  for (int round = 0; round < 3; ++round)
+    std::printf("float: operator %.2f ms, blocks %.2f ms   double: operator %.2f ms, blocks %.2f ms   block diagonal %.2f ms\n",
+                median_ms([&] { op.multiply(x_single, y_single); }), median_ms([&] { multiply(single, x_single, y_single); }),
+                median_ms([&] { op.multiply(u, y); }), median_ms([&] { multiply(blocks, u, y); }),
+                median_ms([&] { (void)op.inverse_diagonal_blocks(); }));
+}
 
 TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   ShapeResolution resolution;
