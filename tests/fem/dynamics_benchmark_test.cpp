@@ -30,6 +30,16 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
+/// The paper's 44,000-cell tube (42 x 42 x 51), soft tissue E = 3 kPa, nu = 0.45.
+TissueModel tube_44k() {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(42, 42, 51);
+  Material m;
+  m.youngs_modulus_kPa = 3.0;
+  m.poisson_ratio = 0.45;
+  return make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+}
+
 /// Median wall time (ms) of 31 calls.
 template <typename Work>
 double median_ms(Work&& work) {
@@ -47,12 +57,7 @@ double median_ms(Work&& work) {
 // one product cell by cell (CorotatedSystemOperator) against the same matrix assembled as block
 // CSR, in float and double, and the operator's block diagonal. Three rounds; prints only.
 TEST(DynamicsBenchmark, DISABLED_Tube44kSystemProducts) {
-  ShapeResolution resolution;
-  resolution.cells = Vec3i(42, 42, 51);
-  Material m;
-  m.youngs_modulus_kPa = 3.0;
-  m.poisson_ratio = 0.45;
-  const TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+  const TissueModel model = tube_44k();
   const LinkedVolume& volume = model.volume;
   const ElementTable table = make_element_table(model);
   Vector u(3 * static_cast<Eigen::Index>(volume.vertex_count()));
@@ -85,12 +90,7 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSystemProducts) {
 }
 
 TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
-  ShapeResolution resolution;
-  resolution.cells = Vec3i(42, 42, 51);
-  Material m;
-  m.youngs_modulus_kPa = 3.0;
-  m.poisson_ratio = 0.45;
-  TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+  TissueModel model = tube_44k();
   LinkedVolume& volume = model.volume;
   DynamicsSettings settings;
   const char* solver = std::getenv("CLEAVE_BENCH_SOLVER");

@@ -73,9 +73,9 @@ struct DynamicsSettings {
   bool stress_stiffness = true;
   /// The step's system is applied cell by cell (fem/corotated_system_operator.hpp) where the
   /// solver takes it so (the multigrid, between its rebuilds): no assembly of its blocks, and
-  /// products that read the cells' rotations instead of the 3x3 blocks. The assembled matrix is
-  /// still gathered for a setup, a cut and the other solvers. false: assembled every step (the
-  /// reference path: both solve the same system).
+  /// products that read the cells' rotations instead of the 3x3 blocks; steps after a cut too.
+  /// The assembled matrix is still gathered for the first step, a rebuild and the other solvers.
+  /// false: assembled every step (the reference path: both solve the same system).
   bool matrix_free = true;
 };
 
