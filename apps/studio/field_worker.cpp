@@ -7,8 +7,17 @@
 
 namespace cleave::studio {
 
+namespace {
+
+constexpr const char* kUnnamedStage = "computing";  ///< the heartbeat's stage before a job names one
+
+}  // namespace
+
 FieldWorker::FieldWorker(Publish publish, PublishProgress progress)
-    : publish_(std::move(publish)), progress_(std::move(progress)), thread_([this] { run(); }) {}
+    : publish_(std::move(publish)),
+      progress_(std::move(progress)),
+      thread_([this] { run(); }),
+      watcher_([this] { watch(); }) {}
 
 FieldWorker::~FieldWorker() {
   {
@@ -19,6 +28,12 @@ FieldWorker::~FieldWorker() {
   latest_.fetch_add(1);  // whatever runs now is superseded
   wake_.notify_all();
   thread_.join();
+  {
+    std::lock_guard lock(report_mutex_);
+    watcher_stopping_ = true;
+  }
+  report_wake_.notify_all();
+  watcher_.join();
 }
 
 std::uint64_t FieldWorker::submit(Job job) {
@@ -38,8 +53,39 @@ void FieldWorker::wait_idle() {
   idle_.wait(lock, [this] { return (!pending_ && !busy_) || stopping_; });
 }
 
+void FieldWorker::forward_locked(std::uint64_t generation) {
+  last_forwarded_ = Clock::now();
+  if (progress_ && latest_.load() == generation)
+    progress_({{"type", "progress"}, {"generation", generation}, {"stage", stage_}, {"fraction", fraction_}});
+}
+
+void FieldWorker::report_locked(std::uint64_t generation, std::string_view stage, double fraction) {
+  if (!running_ || running_generation_ != generation) return;
+  stage_ = std::string(stage);
+  fraction_ = fraction;
+  const double elapsed_s = std::chrono::duration<double>(Clock::now() - running_start_).count();
+  if (elapsed_s > kProgressDelay_s) forward_locked(generation);
+}
+
+void FieldWorker::watch() {
+  const auto delay = std::chrono::duration_cast<Clock::duration>(std::chrono::duration<double>(kProgressDelay_s));
+  std::unique_lock lock(report_mutex_);
+  for (;;) {
+    if (watcher_stopping_) return;
+    if (!running_) {
+      report_wake_.wait(lock);
+      continue;
+    }
+    const Clock::time_point due = last_forwarded_ + delay;
+    if (Clock::now() < due) {
+      report_wake_.wait_until(lock, due);  // woken early by the job's end (or a spurious wake): look again
+      continue;
+    }
+    forward_locked(running_generation_);
+  }
+}
+
 void FieldWorker::run() {
-  using Clock = std::chrono::steady_clock;
   for (;;) {
     Job job;
     std::uint64_t generation = 0;
@@ -53,14 +99,21 @@ void FieldWorker::run() {
       busy_ = true;
     }
     started_.fetch_add(1);
-    const auto start = Clock::now();
+    {
+      std::lock_guard lock(report_mutex_);
+      running_ = true;
+      running_generation_ = generation;
+      running_start_ = last_forwarded_ = Clock::now();
+      stage_ = kUnnamedStage;
+      fraction_ = 0.0;
+    }
+    report_wake_.notify_all();
     Context ctx;
     ctx.generation = generation;
     ctx.superseded = [this, generation] { return latest_.load() != generation; };
-    ctx.progress = [this, generation, start](std::string_view stage, double fraction) {
-      const double elapsed_s = std::chrono::duration<double>(Clock::now() - start).count();
-      if (progress_ && elapsed_s > kProgressDelay_s && latest_.load() == generation)
-        progress_({{"type", "progress"}, {"generation", generation}, {"stage", std::string(stage)}, {"fraction", fraction}});
+    ctx.progress = [this, generation](std::string_view stage, double fraction) {
+      std::lock_guard lock(report_mutex_);
+      report_locked(generation, stage, fraction);
     };
     nlohmann::json message;
     try {
@@ -72,6 +125,11 @@ void FieldWorker::run() {
     } catch (const std::bad_alloc&) {
       message = {{"type", "error"}, {"message", "computation failed: out of memory"}};
     }
+    {
+      std::lock_guard lock(report_mutex_);  // a heartbeat in flight is sent before the result
+      running_ = false;
+    }
+    report_wake_.notify_all();
     if (!ctx.superseded() && !message.is_null()) publish_({generation, std::move(message)});
     {
       std::lock_guard lock(mutex_);

@@ -5,13 +5,21 @@
 // and its result is discarded. So after a burst of edits the worker does at most the job in
 // flight plus the last one.
 //
+// Progress: a job that has run longer than kProgressDelay_s is reported at least every
+// kProgressDelay_s (its latest stage and fraction, or "computing" before it named one), whether
+// or not it calls `progress` itself; a second thread keeps that heartbeat. Every progress message
+// of a job is published before its result.
+//
 //   FieldWorker worker([&](FieldWorker::Result r) { broadcast(r.message); });
 //   worker.submit([&](const FieldWorker::Context& ctx) { ...; if (ctx.superseded()) return json{}; ... });
 #include <atomic>
+#include <chrono>
 #include <condition_variable>
 #include <cstdint>
 #include <functional>
 #include <mutex>
+#include <string>
+#include <string_view>
 #include <nlohmann/json.hpp>
 #include <thread>
 
@@ -24,7 +32,7 @@ class FieldWorker {
   struct Context {
     std::uint64_t generation = 0;
     std::function<bool()> superseded;  ///< true once a newer job was submitted
-    ProgressFn progress;               ///< stage and fraction; forwarded after kProgressDelay_s
+    ProgressFn progress;               ///< stage and fraction; forwarded once the job is past kProgressDelay_s
   };
   using Job = std::function<nlohmann::json(const Context&)>;
   struct Result {
@@ -33,11 +41,13 @@ class FieldWorker {
   };
   /// Called on the worker thread with each finished, current result (not for superseded jobs).
   using Publish = std::function<void(Result)>;
-  /// Called on the worker thread with {"type":"progress","generation":g,"stage":s,"fraction":f}
-  /// for jobs that have run longer than kProgressDelay_s.
+  /// Called on the worker or the heartbeat thread (never both at once) with
+  /// {"type":"progress","generation":g,"stage":s,"fraction":f} for the current job once it has
+  /// run longer than kProgressDelay_s, and again at least every kProgressDelay_s until it ends.
   using PublishProgress = std::function<void(nlohmann::json)>;
 
-  /// Work that takes longer than this shows progress (issue 6: a quarter second).
+  /// Work that takes longer than this shows progress (issue 6: a quarter second), and the
+  /// longest a running job goes without a progress message after that.
   static constexpr double kProgressDelay_s = 0.25;
 
   explicit FieldWorker(Publish publish, PublishProgress progress = {});
@@ -54,7 +64,13 @@ class FieldWorker {
   std::uint64_t jobs_started() const { return started_.load(); }
 
  private:
+  using Clock = std::chrono::steady_clock;
   void run();
+  /// The heartbeat thread: forwards the running job's last stage when it has been quiet too long.
+  void watch();
+  /// Records the running job's stage and forwards it when the job is past the delay; needs report_mutex_.
+  void report_locked(std::uint64_t generation, std::string_view stage, double fraction);
+  void forward_locked(std::uint64_t generation);
 
   Publish publish_;
   PublishProgress progress_;
@@ -67,7 +83,21 @@ class FieldWorker {
   std::atomic<std::uint64_t> started_{0};
   bool busy_ = false;
   bool stopping_ = false;
+
+  // The job in flight as the heartbeat sees it (guarded by report_mutex_; progress and the
+  // result's hand-over are serialised by it, so no progress follows a result).
+  std::mutex report_mutex_;
+  std::condition_variable report_wake_;
+  bool running_ = false;
+  bool watcher_stopping_ = false;
+  std::uint64_t running_generation_ = 0;
+  Clock::time_point running_start_;
+  Clock::time_point last_forwarded_;  ///< the job's start until its first progress message
+  std::string stage_;
+  double fraction_ = 0.0;
+
   std::thread thread_;
+  std::thread watcher_;
 };
 
 }  // namespace cleave::studio

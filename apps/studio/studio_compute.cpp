@@ -262,6 +262,7 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
   double step_ms = 0;
   for (int i = 0; i <= kOpeningFrames; ++i) {
     if (ctx.superseded()) return;
+    report(ctx.progress, "opening the wound", 0.5 + 0.2 * i / kOpeningFrames);
     const auto ts = Clock::now();
     if (i > 0) sim.step(kOpeningStep_s);
     const std::vector<Vec3> u = sim.displacement_mm();
@@ -371,7 +372,6 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   displacement_mm_.clear();
   if (has_stress && !requests.empty()) {
     if (user_cuts_changed && !design.cuts.empty()) {
-      report(ctx.progress, "opening the wound", 0.5);
       stream_opening(design, ctx.generation, ctx, timings);
       if (ctx.superseded()) return nullptr;
     }

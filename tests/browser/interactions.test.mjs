@@ -284,7 +284,9 @@ test('a burst of edits supersedes stale work: progress shows, only the newest re
     const computed = r.computations.started - started0;
     assert.ok(computed < acks.length, `computations started for ${acks.length} edits: ${computed}`);
     assert.ok(after.results - before.results < acks.length, `results received: ${after.results - before.results}`);
-    assert.ok(after.progress > before.progress, 'progress messages for work longer than 0.25 s');
+    // The server reports a job once it has run a quarter second (a heartbeat, whatever the job
+    // does), so the newest job's own time decides: on a fast machine the burst may all be quick.
+    if (r.timings_ms.total > 300) assert.ok(after.progress > before.progress, `progress messages for work of ${r.timings_ms.total.toFixed(0)} ms`);
     assert.equal(await page.locator('#progress').isHidden(), true, 'the progress bar goes once the result is in');
     // The page shows the time of every stage.
     const table = await page.locator('#timing-table').textContent();

@@ -5,7 +5,11 @@
 #include <atomic>
 #include <chrono>
 #include <filesystem>
+#include <mutex>
+#include <string>
 #include <thread>
+#include <utility>
+#include <vector>
 #include <unistd.h>
 
 #include "cleave/core/error.hpp"
@@ -163,6 +167,70 @@ TEST(FieldWorker, NewerJobsSupersedeOlderOnesAndOnlyCurrentResultsArePublished) 
   EXPECT_EQ(worker.jobs_started(), 2u) << "the job in flight and the newest one; none of the stale ones";
   ASSERT_EQ(published.size(), 1u) << "the superseded job's result is discarded";
   EXPECT_EQ(published[0], 9u);
+}
+
+/// Every message a worker sends, in order: progress (stage or "result").
+struct SentMessages {
+  std::mutex m;
+  std::vector<std::pair<std::string, std::chrono::steady_clock::time_point>> sent;
+  void add(std::string what) {
+    std::lock_guard lock(m);
+    sent.emplace_back(std::move(what), std::chrono::steady_clock::now());
+  }
+};
+
+TEST(FieldWorker, ASilentJobStillShowsProgressPastAQuarterSecondAndNoneAfterItsResult) {
+  using Clock = std::chrono::steady_clock;
+  SentMessages log;
+  FieldWorker worker([&](FieldWorker::Result) { log.add("result"); },
+                     [&](json p) { log.add(p["stage"].get<std::string>() + "@" + std::to_string(p["generation"].get<std::uint64_t>())); });
+  // One stage named at once (before the delay: not forwarded), then 0.6 s of silent work.
+  const Clock::time_point submitted = Clock::now();
+  worker.submit([&](const FieldWorker::Context& ctx) {
+    ctx.progress("solving", 0.3);
+    std::this_thread::sleep_for(std::chrono::milliseconds(600));
+    return json{{"type", "result"}};
+  });
+  worker.wait_idle();
+  std::lock_guard lock(log.m);
+  ASSERT_GE(log.sent.size(), 2u) << "at least one heartbeat and the result";
+  EXPECT_EQ(log.sent.back().first, "result") << "no progress after the result";
+  // The job ran within [submitted, result]; heartbeats come a quarter second apart from its start.
+  const double window_s = std::chrono::duration<double>(log.sent.back().second - submitted).count();
+  const auto heartbeats = static_cast<double>(log.sent.size() - 1);
+  EXPECT_LE(heartbeats, window_s / FieldWorker::kProgressDelay_s) << "at most one message per quarter second";
+  for (std::size_t i = 0; i + 1 < log.sent.size(); ++i) {
+    EXPECT_EQ(log.sent[i].first, "solving@1") << "the job's last stage, for its own generation";
+    const double at_s = std::chrono::duration<double>(log.sent[i].second - submitted).count();
+    EXPECT_GE(at_s, FieldWorker::kProgressDelay_s) << "nothing before a quarter second";
+  }
+}
+
+TEST(FieldWorker, QuickJobsShowNoProgressAndAnUnnamedSlowJobIsComputing) {
+  SentMessages log;
+  FieldWorker worker([&](FieldWorker::Result) { log.add("result"); },
+                     [&](json p) { log.add(p["stage"].get<std::string>()); });
+  for (int i = 0; i < 5; ++i) {
+    worker.submit([](const FieldWorker::Context& ctx) {
+      ctx.progress("quick", 0.5);
+      return json{{"type", "result"}};
+    });
+    worker.wait_idle();
+  }
+  {
+    std::lock_guard lock(log.m);
+    EXPECT_EQ(log.sent.size(), 5u) << "five results and no progress";
+    log.sent.clear();
+  }
+  worker.submit([](const FieldWorker::Context&) {
+    std::this_thread::sleep_for(std::chrono::milliseconds(400));
+    return json{{"type", "result"}};
+  });
+  worker.wait_idle();
+  std::lock_guard lock(log.m);
+  ASSERT_GE(log.sent.size(), 2u);
+  EXPECT_EQ(log.sent.front().first, "computing");
+  EXPECT_EQ(log.sent.back().first, "result");
 }
 
 }  // namespace
