@@ -4,6 +4,9 @@
 #include "cleave/solve/supernodal_substitution.hpp"
 
 #include <cholmod.h>
+#include <algorithm>
+#include <string>
+#include <vector>
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
@@ -128,6 +131,54 @@ TEST(SupernodalSubstitution, KeepsItsScheduleAcrossRefactorizations) {
       if (it.row() == it.col()) it.valueRef() *= 2.0;
   chol.refactor();
   EXPECT_LT(relative_difference(substituted(sub, chol.factor(), s.b), chol.cholmod_solution(s.b)), 1e-12);
+}
+
+TEST(SupernodalSubstitution, ForwardThenBackwardIsTheSolve) {
+  test::LinearSystem s = block_system();
+  CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  const Eigen::MatrixXd b = Eigen::MatrixXd::Random(s.a.rows(), 4);
+  const Eigen::MatrixXd y = sub.forward_of(chol.factor(), b);
+  // y = L^-1 P b: ||y||^2 = b^T A^-1 b, column by column.
+  const Eigen::MatrixXd x = sub.backward_of(chol.factor(), y);
+  EXPECT_TRUE(x == substituted(sub, chol.factor(), b)) << "the same operations as solve";
+  for (Eigen::Index c = 0; c < b.cols(); ++c) EXPECT_NEAR(y.col(c).squaredNorm(), b.col(c).dot(x.col(c)), 1e-10 * y.col(c).squaredNorm());
+}
+
+// The forward-substituted unit columns W = L^-1 P E of a few rows at one end of the block: their
+// Gram matrix is E^T A^-1 E (what full solves of the unit columns give), W z goes back to A^-1 E z,
+// and only the supernodes above those rows are touched.
+TEST(SupernodalSubstitution, UnitColumnsReachOnlyTheSupernodesAboveThem) {
+  test::LinearSystem s = block_system();
+  CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  const Eigen::Index n = s.a.rows();
+  const std::vector<Eigen::Index> rows = {n - 1, n - 2, n - 30, n - 31, n - 200, n - 201, n - 202};
+  std::vector<Eigen::Index> reached;
+  const Eigen::MatrixXd w = sub.forward_unit_columns(chol.factor(), rows, reached);
+  ASSERT_EQ(w.rows(), static_cast<Eigen::Index>(reached.size()));
+  ASSERT_EQ(w.cols(), static_cast<Eigen::Index>(rows.size()));
+  EXPECT_LT(reached.size(), static_cast<std::size_t>(n) / 2) << "the rows of one end reach part of the factor";
+  EXPECT_TRUE(std::is_sorted(reached.begin(), reached.end()));
+
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t c = 0; c < rows.size(); ++c) e(rows[c], static_cast<Eigen::Index>(c)) = 1.0;
+  const Eigen::MatrixXd columns = chol.cholmod_solution(e);  // A^-1 E
+  const Eigen::MatrixXd gram_reference = e.transpose() * columns;
+  EXPECT_LT(relative_difference(w.transpose() * w, gram_reference), 1e-12);
+
+  Eigen::MatrixXd w_full = Eigen::MatrixXd::Zero(n, w.cols());
+  for (std::size_t i = 0; i < reached.size(); ++i) w_full.row(reached[i]) = w.row(static_cast<Eigen::Index>(i));
+  EXPECT_LT(relative_difference(w_full, sub.forward_of(chol.factor(), e)), 1e-12) << "W is zero off the reached rows";
+  const Eigen::VectorXd z = Eigen::VectorXd::LinSpaced(w.cols(), 1.0, 2.0);
+  EXPECT_LT(relative_difference(sub.backward_of(chol.factor(), w_full * z), columns * z), 1e-12);
+
+  try {
+    sub.forward_unit_columns(chol.factor(), {n}, reached);
+    FAIL() << "expected InputError";
+  } catch (const InputError& err) {
+    EXPECT_EQ(std::string(err.what()), fmt::format("supernodal substitution: unit column row {} is outside 0 to {}", n, n - 1));
+  }
 }
 
 TEST(SupernodalSubstitution, SolvesMatricesWithManyRootsAndWithOneSupernode) {

@@ -9,6 +9,7 @@
 #include <tbb/task_arena.h>
 
 #include <algorithm>
+#include <cstdint>
 #include <queue>
 #include <utility>
 
@@ -145,7 +146,8 @@ SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
   const auto* rows = static_cast<const int*>(factor.s);
 
   // The supernodal elimination tree: a supernode's parent owns the first row below its columns.
-  std::vector<int> supernode_of_column(order_);
+  std::vector<int>& supernode_of_column = supernode_of_column_;
+  supernode_of_column.assign(order_, 0);
   for (std::size_t s = 0; s < supernode_count_; ++s)
     for (int k = super[s]; k < super[s + 1]; ++k) supernode_of_column[static_cast<std::size_t>(k)] = static_cast<int>(s);
   std::vector<int> parent(supernode_count_, -1);
@@ -181,6 +183,10 @@ SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
     for (const int c : children[static_cast<std::size_t>(s)]) candidates.push(c);
   }
   std::sort(top_supernodes_.begin(), top_supernodes_.end());
+  parent_ = parent;
+  const auto* perm = static_cast<const int*>(factor.Perm);
+  inverse_permutation_.resize(order_);
+  for (std::size_t k = 0; k < order_; ++k) inverse_permutation_[perm != nullptr ? static_cast<std::size_t>(perm[k]) : k] = static_cast<int>(k);
 
   subtree_begin_.push_back(0);
   for (; !candidates.empty(); candidates.pop()) {  // heaviest first
@@ -256,11 +262,15 @@ void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::Matri
                     tbb::simple_partitioner());
 }
 
-void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eigen::MatrixXd> b) const {
-  if (static_cast<std::size_t>(b.rows()) != order_ || factor.n != order_ || factor.nsuper != supernode_count_)
+void SupernodalSubstitution::check_order(const cholmod_factor& factor, Eigen::Index rows) const {
+  if (static_cast<std::size_t>(rows) != order_ || factor.n != order_ || factor.nsuper != supernode_count_)
     throw InputError(fmt::format("supernodal substitution: right-hand side has {} rows and the factor order {}; the schedule "
                                  "was made for order {} with {} supernodes",
-                                 b.rows(), factor.n, order_, supernode_count_));
+                                 rows, factor.n, order_, supernode_count_));
+}
+
+void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eigen::MatrixXd> b) const {
+  check_order(factor, b.rows());
   const auto* perm = static_cast<const int*>(factor.Perm);
   const auto permuted = [&](Eigen::Index k) { return perm != nullptr ? perm[k] : k; };
   const auto n = static_cast<Eigen::Index>(order_);
@@ -270,6 +280,88 @@ void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eige
   forward(factor, y);
   backward(factor, y);
   for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
+}
+
+Eigen::MatrixXd SupernodalSubstitution::forward_of(const cholmod_factor& factor, const Eigen::MatrixXd& b) const {
+  check_order(factor, b.rows());
+  const auto* perm = static_cast<const int*>(factor.Perm);
+  const auto n = static_cast<Eigen::Index>(order_);
+  Eigen::MatrixXd y(n, b.cols());
+  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(perm != nullptr ? perm[k] : k);
+  forward(factor, y);
+  return y;
+}
+
+Eigen::MatrixXd SupernodalSubstitution::backward_of(const cholmod_factor& factor, Eigen::MatrixXd y) const {
+  check_order(factor, y.rows());
+  backward(factor, y);
+  const auto* perm = static_cast<const int*>(factor.Perm);
+  const auto n = static_cast<Eigen::Index>(order_);
+  Eigen::MatrixXd b(n, y.cols());
+  for (Eigen::Index k = 0; k < n; ++k) b.row(perm != nullptr ? perm[k] : k) = y.row(k);
+  return b;
+}
+
+Eigen::MatrixXd SupernodalSubstitution::forward_unit_columns(const cholmod_factor& factor, const std::vector<Eigen::Index>& rows,
+                                                             std::vector<Eigen::Index>& reached_rows) const {
+  const auto k = static_cast<Eigen::Index>(rows.size());
+  return forward_sparse(factor, rows, Eigen::MatrixXd::Identity(k, k), reached_rows);
+}
+
+Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& factor, const std::vector<Eigen::Index>& rows,
+                                                       const Eigen::MatrixXd& b_rows, std::vector<Eigen::Index>& reached_rows) const {
+  check_order(factor, static_cast<Eigen::Index>(order_));
+  if (b_rows.rows() != static_cast<Eigen::Index>(rows.size()))
+    throw InputError(fmt::format("supernodal substitution: {} rows of values for {} rows", b_rows.rows(), rows.size()));
+  const auto n = static_cast<Eigen::Index>(order_);
+  // The supernodes reached: each unit column's own and all above it (the rows below a supernode's
+  // columns belong to its ancestors), in elimination order.
+  std::vector<std::uint8_t> reached(supernode_count_, 0);
+  std::vector<int> visit;
+  for (const Eigen::Index r : rows) {
+    if (r < 0 || r >= n) throw InputError(fmt::format("supernodal substitution: unit column row {} is outside 0 to {}", r, n - 1));
+    for (int s = supernode_of_column_[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(r)])];
+         s >= 0 && reached[static_cast<std::size_t>(s)] == 0; s = parent_[static_cast<std::size_t>(s)]) {
+      reached[static_cast<std::size_t>(s)] = 1;
+      visit.push_back(s);
+    }
+  }
+  std::sort(visit.begin(), visit.end());
+  // Compact rows: the reached supernodes' columns one after another (each supernode's stay
+  // contiguous), and each visited supernode's row indices renumbered to them.
+  const auto* super = static_cast<const int*>(factor.super);
+  std::vector<int> slot(order_, -1);
+  reached_rows.clear();
+  for (const int s : visit)
+    for (int k = super[s]; k < super[s + 1]; ++k) {
+      slot[static_cast<std::size_t>(k)] = static_cast<int>(reached_rows.size());
+      reached_rows.push_back(k);
+    }
+  const double* values = values_of(factor);
+  std::vector<Supernode> compact(visit.size());
+  std::size_t index_count = 0;
+  for (std::size_t i = 0; i < visit.size(); ++i) {
+    compact[i] = supernode_of(factor, values, visit[i]);
+    index_count += static_cast<std::size_t>(compact[i].rows);
+  }
+  std::vector<int> renumbered;
+  renumbered.reserve(index_count);
+  for (Supernode& sn : compact) {
+    const std::size_t begin = renumbered.size();
+    for (Eigen::Index i = 0; i < sn.rows; ++i) renumbered.push_back(slot[static_cast<std::size_t>(sn.row_index[i])]);
+    sn.first = slot[static_cast<std::size_t>(sn.first)];
+    sn.row_index = renumbered.data() + begin;
+  }
+  Eigen::MatrixXd w = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(reached_rows.size()), b_rows.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    w.row(slot[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(rows[i])])]) += b_rows.row(static_cast<Eigen::Index>(i));
+  for (const Supernode& sn : compact) {
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      forward_large_supernode(sn, w);
+    else
+      forward_supernode(sn, w, [&](int row, const auto& update) { w.row(row) -= update; });
+  }
+  return w;
 }
 
 }  // namespace cleave
