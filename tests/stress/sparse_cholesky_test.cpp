@@ -75,6 +75,7 @@ constexpr double kTolerance = 1e-13;
 TEST(SparseCholeskyUpdate, ConstraintsAddedRemovedAndMovedAreSolvedWithTheKeptFactor) {
   const std::vector<int> first = {5, 100, 333, 900, 1500};
   SparseCholesky chol;
+  chol.set_update_policy(SparseCholesky::UpdatePolicy::columns);  // (the default chooses by measured cost)
   const Eigen::SparseMatrix<double> a0 = design_system(kSide, first, kConstraint);
   chol.factorize(a0);
   Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
@@ -118,10 +119,54 @@ TEST(SparseCholeskyUpdate, ConstraintsAddedRemovedAndMovedAreSolvedWithTheKeptFa
   ASSERT_TRUE(chol.solve_with_current_factor(a0, b0, x, kTolerance, 40));
   EXPECT_GT(chol.last_factor_solves(), 0);
   EXPECT_LT(relative_error(x, Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a0).solve(b0)), 1e-9);
+  // The same system once more (an undo and a redo): its remembered solution, bit for bit.
+  const Eigen::MatrixXd solved = x;
+  x.setZero();
+  EXPECT_EQ(chol.remembered_solves(), 0);
+  ASSERT_TRUE(chol.solve_with_current_factor(a0, b0, x, kTolerance, 40));
+  EXPECT_EQ(chol.remembered_solves(), 1);
+  EXPECT_EQ(chol.last_factor_solves(), 0);
+  EXPECT_TRUE(x == solved);
 
   // A new factorization drops the kept columns.
   chol.factorize(design_system(kSide, edits.back(), kConstraint));
   EXPECT_EQ(chol.low_rank_rows(), 0);
+}
+
+// The sparse update (forward-substituted unit columns of the changed rows only, no columns of G
+// kept): the same edits, each the solution of its system, none of them refactorized.
+TEST(SparseCholeskyUpdate, TheSparseUpdateSolvesTheSameEditsWithoutKeepingColumns) {
+  const std::vector<int> first = {5, 100, 333, 900, 1500};
+  SparseCholesky chol;
+  chol.set_update_policy(SparseCholesky::UpdatePolicy::sparse);
+  const Eigen::SparseMatrix<double> a0 = design_system(kSide, first, kConstraint);
+  chol.factorize(a0);
+  Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
+  // A stroke-like edit (a row of 60 fresh cells), the constraints moved, one back, the stroke-like
+  // edit again, and once more (as after an undo and a redo: the remembered solution, no solve).
+  std::vector<int> stroke = first;
+  for (int i = 0; i < 60; ++i) stroke.push_back(kSide * kSide * 6 + kSide * 3 + i);
+  const std::vector<std::vector<int>> edits = {stroke, {6, 101, 334, 901, 1501}, {5, 100, 333, 900, 1500, 6}, stroke, stroke};
+  const std::vector<bool> needs_solves = {true, true, true, true, false};
+  const std::vector<int> sparse_solves = {1, 2, 3, 4, 4};
+  const std::vector<int> remembered = {0, 0, 0, 0, 1};
+  for (std::size_t e = 0; e < edits.size(); ++e) {
+    SCOPED_TRACE(e);
+    const Eigen::SparseMatrix<double> a = design_system(kSide, edits[e], kConstraint);
+    const Eigen::MatrixXd b = targets(kCells, edits[e], kConstraint);
+    ASSERT_TRUE(chol.solve_with_current_factor(a, b, x, kTolerance, 40));
+    const Eigen::MatrixXd reference = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a).solve(b);
+    EXPECT_LT(relative_error(x, reference), 1e-9);
+    EXPECT_LE(backward_error(a, x, b), kTolerance);
+    EXPECT_EQ(chol.last_iterations(), 0);
+    EXPECT_EQ(chol.sparse_update_solves(), sparse_solves[e]);
+    EXPECT_EQ(chol.low_rank_solves(), sparse_solves[e]);
+    EXPECT_EQ(chol.remembered_solves(), remembered[e]);
+    EXPECT_EQ(chol.last_factor_solves() > 0, needs_solves[e]) << chol.last_factor_solves() << " solves";
+    EXPECT_LE(chol.last_factor_solves(), 1 + SparseCholesky::kLowRankRefinementSteps);
+    EXPECT_EQ(chol.low_rank_rows(), 0) << "no columns of G are bought";
+  }
+  EXPECT_EQ(chol.reused_analyses(), 0) << "no refactorization";
 }
 
 TEST(SparseCholeskyUpdate, TooManyChangedRowsFallBackToTheCaller) {

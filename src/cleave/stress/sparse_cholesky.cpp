@@ -132,6 +132,22 @@ class CholmodLlt : public Eigen::CholmodSupernodalLLT<Eigen::SparseMatrix<double
   const cholmod_factor* factor() const { return m_cholmodFactor; }
 };
 
+/// Before the sparse update has been measured, one of its changed rows is taken to cost this
+/// share of a full solve of one column (measured: 1/9 for a stroke of the abdomen at 45k cells).
+constexpr double kSparseRowShareOfSolve = 0.25;
+
+/// The sparse update's first forward substitution visits only the supernodes above b's rows while
+/// b is non-zero on at most this share of them (the design's targets sit on the constrained cells).
+constexpr double kSparseRightHandSideShare = 0.25;
+
+/// The sparse update replaces new columns of G only when those would cost this many times more:
+/// columns are kept and answer every later edit on their rows without a solve (a control point
+/// placed, moved and typed at), the sparse update is paid again at every edit.
+constexpr double kSparseAdvantage = 2.0;
+
+/// Solutions kept for systems that come back (an undo and a redo, a drag back and forth).
+constexpr std::size_t kRememberedSolutions = 2;
+
 /// Right-hand sides up to this many columns are substituted on all cores (SupernodalSubstitution);
 /// wider blocks go to CHOLMOD's solve, whose BLAS-3 kernels already use them.
 constexpr Eigen::Index kParallelSubstitutionColumns = 8;
@@ -154,6 +170,35 @@ struct SparseCholesky::Impl {
   Eigen::MatrixXd low_rank_columns;
   std::vector<Eigen::Index> low_rank_row;
   std::vector<Eigen::Index> column_of_row;
+  // Sparse update (UpdatePolicy::sparse): W = L^-1 P E of the changed rows `sparse_rows`, on the
+  // permuted rows `sparse_reached` (where it is not zero), and W^T W = E^T a0^-1 E. Kept while
+  // an edit changes the same rows (a drag back, undo, redo); emptied by every factorization.
+  std::vector<Eigen::Index> sparse_rows;
+  std::vector<Eigen::Index> sparse_reached;
+  Eigen::MatrixXd sparse_w;
+  Eigen::MatrixXd sparse_gram;
+  double sparse_row_seconds = 0;    ///< per changed row, for W and W^T W (0: not measured yet)
+  double sparse_apply_seconds = 0;  ///< per right-hand side column: the first application of the update
+  // The last kRememberedSolutions systems solved with this factor (their diagonal and b: the
+  // off-diagonal entries are the factorized ones) and their solutions, newest first.
+  struct Remembered {
+    Eigen::VectorXd diagonal;
+    Eigen::MatrixXd b;
+    Eigen::MatrixXd x;
+  };
+  std::vector<Remembered> remembered;
+
+  /// The remembered solution of the system with this diagonal (off-diagonal entries the factorized
+  /// ones) and right-hand side, or null.
+  const Eigen::MatrixXd* remembered_solution(const Eigen::VectorXd& a_diagonal, const Eigen::MatrixXd& b) const {
+    for (const Remembered& r : remembered)
+      if (r.b.rows() == b.rows() && r.b.cols() == b.cols() && r.diagonal == a_diagonal && r.b == b) return &r.x;
+    return nullptr;
+  }
+  void remember(Eigen::VectorXd a_diagonal, const Eigen::MatrixXd& b, const Eigen::MatrixXd& x) {
+    remembered.insert(remembered.begin(), Remembered{std::move(a_diagonal), b, x});
+    if (remembered.size() > kRememberedSolutions) remembered.pop_back();
+  }
 
   bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
     if (!analyzed || static_cast<std::size_t>(a.outerSize() + 1) != outer.size()) return false;
@@ -203,6 +248,11 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   impl_->low_rank_columns.resize(0, 0);
   impl_->low_rank_row.clear();
   impl_->column_of_row.assign(static_cast<std::size_t>(a.rows()), -1);
+  impl_->sparse_rows.clear();
+  impl_->sparse_reached.clear();
+  impl_->sparse_w.resize(0, 0);
+  impl_->sparse_gram.resize(0, 0);
+  impl_->remembered.clear();
 }
 
 Eigen::Index SparseCholesky::low_rank_rows() const { return static_cast<Eigen::Index>(impl_->low_rank_row.size()); }
@@ -229,16 +279,24 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
   const double refactor_seconds =
       impl_->factor_seconds + static_cast<double>(b.cols()) * (kRefinementSteps + 1) * impl_->solve_seconds;
   if (impl_->same_values(a)) {  // only the right-hand side changed: the factor is exact
+    const Eigen::VectorXd a_diagonal = a.diagonal();
+    if (const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b)) {
+      x = *known;
+      ++remembered_solves_;
+      return true;
+    }
     // Without a solve when G has a column for every row where b is not zero (a value typed at a
     // control point the last edits placed); otherwise refined as solve_refined does, but only
     // until the tolerance is met (usually one step).
-    if (low_rank_rows() > 0 && solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, false)) return true;
-    x = solve(b);
-    ++last_factor_solves_;
-    refine(a, norm_1(a), b, x, relative_tolerance, kRefinementSteps, [&](const Eigen::MatrixXd& r) {
+    if (!(low_rank_rows() > 0 && solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, false))) {
+      x = solve(b);
       ++last_factor_solves_;
-      return solve(r);
-    });
+      refine(a, norm_1(a), b, x, relative_tolerance, kRefinementSteps, [&](const Eigen::MatrixXd& r) {
+        ++last_factor_solves_;
+        return solve(r);
+      });
+    }
+    impl_->remember(a_diagonal, b, x);
     return true;
   }
   // A change of d diagonal entries only (constraints added or removed) is a rank-d update: CG with
@@ -253,8 +311,17 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
         diagonal_only = diagonal_only && a.innerIndexPtr()[k] == j;
       }
   if (diagonal_only) {
+    Eigen::VectorXd a_diagonal = a.diagonal();
+    if (const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b)) {
+      x = *known;
+      ++remembered_solves_;
+      return true;
+    }
     const Eigen::MatrixXd start = x;
-    if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, true)) return true;
+    if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, true)) {
+      impl_->remember(std::move(a_diagonal), b, x);
+      return true;
+    }
     x = start;
   }
   Eigen::Index columns = 0;
@@ -340,6 +407,20 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
            static_cast<double>(count) * column_seconds <= kColumnBudget * refactor_seconds;
   };
   const std::size_t support_columns = missing_changed.size() + missing_support.size();
+  // Changed rows without columns (a stroke drawn or dragged over fresh cells): their columns cost
+  // a full solve each, the sparse update only the part of the factor above them.
+  const bool sparse_possible = new_columns_allowed && impl.substitution.has_value() && !changed.empty() &&
+                               static_cast<Eigen::Index>(changed.size()) <= kMaxLowRankRows &&
+                               8.0 * static_cast<double>(n) * static_cast<double>(changed.size()) <= kMaxLowRankBytes;
+  if (sparse_possible && policy_ != UpdatePolicy::columns && (policy_ == UpdatePolicy::sparse || !missing_changed.empty())) {
+    const double sparse_seconds = changed == impl.sparse_rows ? sparse_update_seconds(0, b.cols()) : sparse_update_seconds(changed.size(), b.cols());
+    const double column_path_seconds =
+        static_cast<double>(support_columns) * column_seconds + static_cast<double>(b.cols()) * impl.solve_seconds;
+    if (policy_ == UpdatePolicy::sparse ||
+        (sparse_seconds <= refactor_seconds &&
+         (kSparseAdvantage * sparse_seconds < column_path_seconds || !affordable(missing_changed.size()))))
+      return solve_sparse_update(a, b, x, relative_tolerance, changed, change);
+  }
   // y = a0^-1 b from G's columns of the rows where b is not zero (no solve), when they exist or can
   // be afforded; otherwise from a solve with the factor. The right-hand side's extra columns are
   // bought at once only while cheap (one refactorization); dearer, only by an edit whose changed
@@ -451,6 +532,74 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
     }
   }
   if (converged) ++low_rank_solves_;
+  return converged;
+}
+
+double SparseCholesky::sparse_update_seconds(std::size_t rows, Eigen::Index columns) const {
+  const Impl& impl = *impl_;
+  const double row_seconds = impl.sparse_row_seconds > 0 ? impl.sparse_row_seconds : kSparseRowShareOfSolve * impl.solve_seconds;
+  const double apply_seconds = impl.sparse_apply_seconds > 0 ? impl.sparse_apply_seconds : impl.solve_seconds;
+  // W for the new rows, then the update applied to b and once more to refine it.
+  return static_cast<double>(rows) * row_seconds + 2.0 * static_cast<double>(columns) * apply_seconds;
+}
+
+bool SparseCholesky::solve_sparse_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+                                         double relative_tolerance, const std::vector<Eigen::Index>& changed,
+                                         const Eigen::VectorXd& change) const {
+  Impl& impl = *impl_;
+  const cholmod_factor& factor = *impl.llt.factor();
+  const SupernodalSubstitution& substitution = *impl.substitution;
+  if (changed != impl.sparse_rows) {
+    const Clock::time_point start = Clock::now();
+    impl.sparse_rows.clear();  // not valid until W and its Gram matrix are made
+    impl.sparse_w = substitution.forward_unit_columns(factor, changed, impl.sparse_reached);
+    impl.sparse_gram.noalias() = impl.sparse_w.transpose() * impl.sparse_w;
+    if (!impl.sparse_gram.allFinite()) return false;
+    impl.sparse_rows = changed;
+    impl.sparse_row_seconds = seconds_between(start, Clock::now()) / static_cast<double>(changed.size());
+  }
+  // a = a0 + E D E^T: a^-1 r = P^T L^-T (y - W Z), y = L^-1 P r, Z = (I + D W^T W)^-1 D W^T y.
+  const auto rank = static_cast<Eigen::Index>(changed.size());
+  const Eigen::VectorXd d = change(changed);
+  Eigen::MatrixXd capacitance = d.asDiagonal() * impl.sparse_gram;
+  capacitance.diagonal().array() += 1.0;
+  const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
+  const auto& reached = impl.sparse_reached;
+  // From y = L^-1 P r: the correction on W's rows, then the back substitution.
+  const auto update_and_back = [&](Eigen::MatrixXd y) {
+    Eigen::MatrixXd y_reached(static_cast<Eigen::Index>(reached.size()), y.cols());
+    for (std::size_t i = 0; i < reached.size(); ++i) y_reached.row(static_cast<Eigen::Index>(i)) = y.row(reached[i]);
+    const Eigen::MatrixXd z = lu.solve(d.asDiagonal() * (impl.sparse_w.transpose() * y_reached));
+    y_reached.noalias() = impl.sparse_w * z;
+    for (std::size_t i = 0; i < reached.size(); ++i) y.row(reached[i]) -= y_reached.row(static_cast<Eigen::Index>(i));
+    return substitution.backward_of(factor, std::move(y));
+  };
+  const auto solve_updated = [&](const Eigen::MatrixXd& r) {
+    ++last_factor_solves_;
+    return update_and_back(substitution.forward_of(factor, r));
+  };
+  const Clock::time_point start = Clock::now();
+  // b lives on the constrained cells: its forward substitution reaches only the supernodes above them.
+  std::vector<Eigen::Index> support;
+  for (Eigen::Index r = 0; r < b.rows(); ++r)
+    if ((b.row(r).array() != 0.0).any()) support.push_back(r);
+  if (static_cast<double>(support.size()) <= kSparseRightHandSideShare * static_cast<double>(b.rows())) {
+    ++last_factor_solves_;
+    std::vector<Eigen::Index> reached_by_b;
+    const Eigen::MatrixXd y_reached = substitution.forward_sparse(factor, support, b(support, Eigen::all), reached_by_b);
+    Eigen::MatrixXd y = Eigen::MatrixXd::Zero(b.rows(), b.cols());
+    for (std::size_t i = 0; i < reached_by_b.size(); ++i) y.row(reached_by_b[i]) = y_reached.row(static_cast<Eigen::Index>(i));
+    x = update_and_back(std::move(y));
+  } else {
+    x = solve_updated(b);
+  }
+  if (b.cols() > 0) impl.sparse_apply_seconds = seconds_between(start, Clock::now()) / static_cast<double>(b.cols());
+  if (rank == 0 || !x.allFinite()) return false;
+  const bool converged = refine(a, norm_1(a), b, x, relative_tolerance, kLowRankRefinementSteps, solve_updated);
+  if (converged) {
+    ++low_rank_solves_;
+    ++sparse_update_solves_;
+  }
   return converged;
 }
 

@@ -11,6 +11,7 @@
 #include <Eigen/Core>
 #include <Eigen/SparseCore>
 #include <memory>
+#include <vector>
 
 namespace cleave {
 
@@ -50,6 +51,8 @@ class SparseCholesky {
   /// point: also for a right-hand-side-only change), the solve is dense algebra on G and a
   /// residual check. Its rounding error sits on the changed rows, so G's columns also refine it;
   /// a solve with the factor refines only what they cannot (see kMaxLowRankRows).
+  /// Changed rows without columns may instead be solved by the sparse update (UpdatePolicy), and a
+  /// system solved before with this factor gets its remembered solution (remembered_solves).
   /// Returns true when every column reached the tolerance: CG a relative residual
   /// ||b - a x|| <= relative_tolerance ||b||, the solves with the factor and the Woodbury update a
   /// normwise backward error ||b - a x|| / (||a||_1 ||x|| + ||b||) <= relative_tolerance (the
@@ -78,6 +81,28 @@ class SparseCholesky {
   /// Numeric factorizations that could reuse the previous symbolic analysis.
   int reused_analyses() const { return reused_; }
 
+  /// How a diagonal edit whose changed rows lack columns of G is solved with the kept factor.
+  /// `cheaper` (the default) takes whichever of the two is estimated faster from the last
+  /// measured costs; the others force one (tests, comparisons).
+  ///  - columns: buy the missing columns of G (a full solve per column; kept for later edits);
+  ///  - sparse: the forward-substituted unit columns W = L^-1 P E, made only on the supernodes
+  ///    above the changed rows (a stroke's 142 rows reach 13 % of the rows at 45k cells), then
+  ///      a^-1 b = P^T L^-T (y - W (I + D W^T W)^-1 D W^T y),   y = L^-1 P b,
+  ///    one forward substitution of b (over the supernodes above its rows) and one back
+  ///    substitution (W and W^T W kept while the changed rows stay the same); refined by the same
+  ///    formula. Nothing is kept for later edits on other rows, so a stroke drawn or dragged over
+  ///    fresh cells costs the same as one moved back (docs/stress-design.md, "Sparse update").
+  enum class UpdatePolicy { cheaper, columns, sparse };
+  void set_update_policy(UpdatePolicy policy) { policy_ = policy; }
+  /// Calls of solve_with_current_factor answered by the sparse update (a subset of low_rank_solves).
+  int sparse_update_solves() const { return sparse_update_solves_; }
+  /// Calls of solve_with_current_factor answered by a remembered solution: the last two systems
+  /// solved with this factor (without CG: the factorized matrix or a diagonal change of it) are
+  /// kept with their right-hand sides, so that an undo and a redo, or a stroke dragged back and
+  /// forth, need no solve. Forgotten at every factorization. (The solution met the tolerance of
+  /// the call that made it; each design system keeps one tolerance.)
+  int remembered_solves() const { return remembered_solves_; }
+
  private:
   struct Impl;
   std::unique_ptr<Impl> impl_;
@@ -86,6 +111,14 @@ class SparseCholesky {
   /// or, without new_columns_allowed, when G lacks a column it needs.
   bool solve_diagonal_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
                              double relative_tolerance, double refactor_seconds, bool new_columns_allowed) const;
+  /// The sparse update (see UpdatePolicy) over the changed rows `changed`, a = a0 + diag(change).
+  bool solve_sparse_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
+                           double relative_tolerance, const std::vector<Eigen::Index>& changed, const Eigen::VectorXd& change) const;
+  /// Seconds the sparse update of `rows` changed rows and `columns` right-hand sides is expected to take.
+  double sparse_update_seconds(std::size_t rows, Eigen::Index columns) const;
+  UpdatePolicy policy_ = UpdatePolicy::cheaper;
+  mutable int sparse_update_solves_ = 0;
+  mutable int remembered_solves_ = 0;
   int reused_ = 0;
   mutable int last_iterations_ = 0;
   mutable int last_factor_solves_ = 0;
