@@ -31,6 +31,8 @@ std::string_view stage_key(Stage stage) {
     case Stage::preview: return "preview";
     case Stage::step: return "step";
     case Stage::update: return "update";
+    case Stage::vector_drag: return "vector_drag";
+    case Stage::update_drag: return "update_drag";
   }
   return "vector";
 }
@@ -44,6 +46,8 @@ StageFigures& ImplementationFigures::stage(Stage s) {
     case Stage::preview: return preview;
     case Stage::step: return step;
     case Stage::update: return update;
+    case Stage::vector_drag: return vector_drag;
+    case Stage::update_drag: return update_drag;
   }
   return vector;
 }

@@ -12,6 +12,8 @@
 //   preview      one incision-preview solve: statics of the body with round incisions cut
 //   step         one implicit corotational Newmark step during an ongoing cut
 //   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface
+//   vector_drag  the eigenvector stage of a stroke dragged over fresh cells (one cell per edit)
+//   update_drag  the edit-to-picture update of those edits
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -36,10 +38,10 @@ std::string_view implementation_key(Implementation implementation);
 /// Inverse of implementation_key; throws InputError naming `option` and listing the keys.
 Implementation implementation_from_key(std::string_view key, std::string_view option);
 
-enum class Stage { vector, value, value_point, equilibrate, preview, step, update };
-inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value, Stage::value_point, Stage::equilibrate,
-                                       Stage::preview, Stage::step, Stage::update};
-/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update".
+enum class Stage { vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag };
+inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value,  Stage::value_point, Stage::equilibrate, Stage::preview,
+                                       Stage::step,   Stage::update, Stage::vector_drag, Stage::update_drag};
+/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update", "vector_drag", "update_drag".
 std::string_view stage_key(Stage stage);
 
 struct StageFigures {
@@ -53,7 +55,7 @@ struct StageFigures {
 struct ImplementationFigures {
   Implementation implementation = Implementation::cleave;
   std::string solver;  ///< the solver's own name as it reports it
-  StageFigures vector, value, value_point, equilibrate, preview, step, update;
+  StageFigures vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag;
   double peak_mb = 0;  ///< peak resident memory while this implementation ran (MB = 1e6 bytes)
 
   StageFigures& stage(Stage s);

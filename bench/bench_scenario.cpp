@@ -128,7 +128,10 @@ BenchScenario make_bench_scenario(const TissueModel& model, const ScenarioOption
   BenchScenario s;
   s.design = bench_design(surface, model);
   const auto [lo, hi] = model.bounding_box_mm();
-  s.edited_stroke = stroke_across_top(surface, model, lo.z() + (hi.z() - lo.z()) / 3.0 + surface.cell_size_mm());
+  const double stroke_z_mm = lo.z() + (hi.z() - lo.z()) / 3.0;
+  s.edited_stroke = stroke_across_top(surface, model, stroke_z_mm + surface.cell_size_mm());
+  for (int i = 1; i <= kDragEdits && stroke_z_mm - (i + 1) * surface.cell_size_mm() > lo.z(); ++i)
+    s.dragged_strokes.push_back(stroke_across_top(surface, model, stroke_z_mm - i * surface.cell_size_mm()));
   s.designed_stress = options.designed_stress;
   s.residual_stress_kPa = s.designed_stress ? design_residual_stress(model, s.design).stress_kPa
                                             : prescribed_biaxial_stress(model, kLangerTension_kPa, kCrossTension_kPa);

@@ -5,6 +5,8 @@
 //     across the top of the body along x (the tube's circumference, the abdomen's horizontal
 //     lines) at 1/3 and 2/3 of its length, and five control points on top,
 //   - the edit of the edit-to-picture update: stroke 0 moved by one cell along z,
+//   - a drag: stroke 0 moved one more cell towards the body's near end at every edit (fresh cells
+//     each time, as a stroke dragged or drawn anew in the studio),
 //   - the residual stress of the body (one Voigt tensor per cell, kPa): the design's result, or,
 //     where the design cannot run (`designed_stress = false`: models above
 //     `cleave bench --design-max-cells`, whose design factor would not fit in memory), a
@@ -28,6 +30,9 @@
 
 namespace cleave::bench {
 
+/// Edits of the drag (fewer where the body is too short for them).
+inline constexpr int kDragEdits = 8;
+
 struct ScenarioOptions {
   int cut_segments = 8;  ///< pieces the scalpel cut is applied in (one per dynamic step)
   /// false: no design is computed; the residual stress is the prescribed biaxial one (see above).
@@ -37,6 +42,7 @@ struct ScenarioOptions {
 struct BenchScenario {
   StressDesign design;
   DesignStroke edited_stroke;              ///< replaces design.strokes[0] in the update edit
+  std::vector<DesignStroke> dragged_strokes;  ///< stroke 0 at 1, 2, ... cells towards lo.z (at most kDragEdits)
   std::vector<Vec6> residual_stress_kPa;   ///< per cell of the uncut model
   CutRequests incisions;                   ///< the preview's round incisions
   std::vector<ScalpelCut> cut_segments;    ///< consecutive pieces of the ongoing scalpel cut

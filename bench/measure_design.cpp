@@ -86,21 +86,33 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
   kept.solver = SolverKind::cholmod;
   kept.fixed_vertices = preview.held;
   StaticSolver statics(preview.model, preview.stiffness, kept);
-  for (int edit = 0; edit < repeat; ++edit) {
-    update_ms.push_back(wall_time_ms([&] {
-      designer.move_stroke(0, stroke_of_edit(scenario, edit));
+  const auto stroke_edit = [&](const DesignStroke& stroke) {
+    return wall_time_ms([&] {
+      designer.move_stroke(0, stroke);
       const StaticResult solved = statics.solve(designer.result().stress_kPa);
       picture_mm = deformed_positions(preview.surface, preview.model.volume, solved.displacement_mm);
       preview_iterations = solved.report.iterations;
-    }));
+    });
+  };
+  for (int edit = 0; edit < repeat; ++edit) {
+    update_ms.push_back(stroke_edit(stroke_of_edit(scenario, edit)));
     const DesignTimings& t = designer.result().timings;
     vector_ms.push_back(kMsPerSecond * t.directions_s);
     value_ms.push_back(kMsPerSecond * t.eigenvalues_s);
     equilibrate_ms.push_back(kMsPerSecond * t.equilibration_s);
     equilibrate_iterations = std::max(equilibrate_iterations, designer.result().equilibration_iterations);
   }
+  std::vector<double> drag_vector_ms, drag_update_ms;
+  for (const DesignStroke& stroke : scenario.dragged_strokes) {
+    drag_update_ms.push_back(stroke_edit(stroke));
+    drag_vector_ms.push_back(kMsPerSecond * designer.result().timings.directions_s);
+  }
+  designer.move_stroke(0, stroke_of_edit(scenario, repeat - 1));
   DesignOutcome out;
   out.line_tensors = frame_line_tensors(designer.result().frames);
+  out.vector_drag.time = summarize_timings(drag_vector_ms);
+  out.update_drag.time = summarize_timings(drag_update_ms);
+  out.update_drag.iterations = preview_iterations;
   out.vector.time = summarize_timings(vector_ms);
   out.value.time = summarize_timings(value_ms);
   out.value.iterations = designer.result().eigenvalue_iterations;
@@ -130,7 +142,15 @@ DesignOutcome measure_paper(const TissueModel& uncut, const BenchScenario& scena
     designer.move_stroke(0, strokes.front());
     value_ms.push_back(kMsPerSecond * designer.result().timings.eigenvalues_s);
   }
+  std::vector<double> drag_vector_ms;
+  for (const DesignStroke& stroke : scenario.dragged_strokes) {
+    std::vector<DesignStroke> strokes = design.strokes;
+    strokes.front() = stroke;
+    drag_vector_ms.push_back(wall_time_ms([&] { directions.interpolate(strokes); }));
+  }
   DesignOutcome out;
+  out.vector_drag.time = summarize_timings(drag_vector_ms);
+  out.update_drag.skipped = "the paper's pipeline has no edit-to-picture update";
   out.vector.time = summarize_timings(vector_ms);
   out.vector.iterations = paper_frames.iterations;
   out.value.time = summarize_timings(value_ms);
@@ -156,7 +176,8 @@ DesignOutcome measure_design(const TissueModel& uncut, const BenchScenario& scen
   }
   DesignOutcome out;
   const std::string why = "cleave's design stages already use CHOLMOD (supernodal, analysis reused)";
-  out.vector.skipped = out.value.skipped = out.value_point.skipped = out.equilibrate.skipped = why;
+  out.vector.skipped = out.value.skipped = out.value_point.skipped = out.equilibrate.skipped = out.vector_drag.skipped =
+      out.update_drag.skipped = why;
   return out;
 }
 

@@ -4,6 +4,8 @@
 // Every implementation makes the same edits:
 //   stroke edits          `repeat` times: stroke 0 alternates between the scenario's edited stroke
 //                         and its original, so each edit is a real change;
+//   a drag                then stroke 0 over fresh cells, one cell further at every edit (the
+//                         scenario's dragged strokes), then back to where the stroke edits left it;
 //   control-point edits   then `repeat` times, in turn: add a control point (at the middle of the
 //                         edited stroke, Langer 25 / cross 15 kPa), move it (to the middle of the
 //                         original stroke 0), delete it;
@@ -16,10 +18,11 @@
 //           update = the whole stroke edit as the studio does it: the designer's update, the
 //           incision preview solve with the new stress on the incised body (stiffness assembled
 //           once, cut topology unchanged by a stroke edit) and the deformed render surface.
+//           vector_drag / update_drag: the same two for the drag's edits.
 //   paper   one thread; vector = PaperDirections (plain CG, Langer and normal fields, warm
 //           started), value / value_point = StressDesigner with EigenvalueSolver::paper_cg (the
 //           paper's CG on A^T A, warm-started from the previous eigenvalues); equilibrate is not
-//           the paper's.
+//           the paper's; vector_drag = PaperDirections for the drag's edits.
 //   others  Eigen CG and CHOLMOD do not apply to the design stages by themselves: cleave's design
 //           already uses CHOLMOD (recorded as skipped with that reason).
 //
@@ -31,7 +34,7 @@
 namespace cleave::bench {
 
 struct DesignOutcome {
-  StageFigures vector, value, value_point, equilibrate, update;
+  StageFigures vector, value, value_point, equilibrate, update, vector_drag, update_drag;
   Eigen::VectorXd line_tensors;  ///< frame_line_tensors of the final frames
   Eigen::VectorXd eigenvalues_kPa;  ///< 3 per cell (Langer, cross, normal)
 };

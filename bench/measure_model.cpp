@@ -44,10 +44,13 @@ ImplementationResults run_implementation(const TissueModel& model, const BenchSc
     r.figures.value_point = design.value_point;
     r.figures.equilibrate = design.equilibrate;
     r.figures.update = design.update;
+    r.figures.vector_drag = design.vector_drag;
+    r.figures.update_drag = design.update_drag;
     r.line_tensors = std::move(design.line_tensors);
     r.eigenvalues_kPa = std::move(design.eigenvalues_kPa);
   } else {
-    for (StageFigures* s : {&r.figures.vector, &r.figures.value, &r.figures.value_point, &r.figures.equilibrate, &r.figures.update})
+    for (StageFigures* s : {&r.figures.vector, &r.figures.value, &r.figures.value_point, &r.figures.equilibrate, &r.figures.update,
+                            &r.figures.vector_drag, &r.figures.update_drag})
       s->skipped = design_skipped;
   }
   report(progress, who + ": incision preview", done + 0.4 * share);
