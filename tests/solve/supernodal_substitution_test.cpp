@@ -3,7 +3,6 @@
 // (the blocked, parallel path), several elimination-tree roots and a single supernode.
 #include "cleave/solve/supernodal_substitution.hpp"
 
-#include <cholmod.h>
 #include <algorithm>
 #include <string>
 #include <vector>
@@ -12,71 +11,11 @@
 #include <tbb/global_control.h>
 
 #include "cleave/core/error.hpp"
+#include "cholmod_test_factor.hpp"
 #include "solve_test_systems.hpp"
 
 namespace cleave {
 namespace {
-
-/// CHOLMOD's supernodal LL^T of a symmetric matrix stored whole (its upper triangle is read).
-class CholmodFactor {
- public:
-  explicit CholmodFactor(SparseMatrix& a) : a_(a) {
-    cholmod_start(&common_);
-    common_.supernodal = CHOLMOD_SUPERNODAL;
-    common_.print = 0;
-    factor_ = cholmod_analyze(view(), &common_);
-    refactor();
-  }
-  ~CholmodFactor() {
-    cholmod_free_factor(&factor_, &common_);
-    cholmod_finish(&common_);
-  }
-  CholmodFactor(const CholmodFactor&) = delete;
-  CholmodFactor& operator=(const CholmodFactor&) = delete;
-
-  /// Numeric factorization of a_'s current values (same analysis).
-  void refactor() {
-    cholmod_factorize(view(), factor_, &common_);
-    ASSERT_EQ(factor_->minor, factor_->n) << "test matrix not positive definite";
-  }
-  const cholmod_factor& factor() const { return *factor_; }
-
-  /// x = A^-1 b by cholmod_solve: the reference.
-  Eigen::MatrixXd cholmod_solution(const Eigen::MatrixXd& b) {
-    cholmod_dense rhs{};
-    rhs.nrow = static_cast<std::size_t>(b.rows());
-    rhs.ncol = static_cast<std::size_t>(b.cols());
-    rhs.nzmax = rhs.nrow * rhs.ncol;
-    rhs.d = rhs.nrow;
-    rhs.x = const_cast<double*>(b.data());
-    rhs.xtype = CHOLMOD_REAL;
-    rhs.dtype = CHOLMOD_DOUBLE;
-    cholmod_dense* x = cholmod_solve(CHOLMOD_A, factor_, &rhs, &common_);
-    Eigen::MatrixXd out = Eigen::Map<const Eigen::MatrixXd>(static_cast<const double*>(x->x), b.rows(), b.cols());
-    cholmod_free_dense(&x, &common_);
-    return out;
-  }
-
- private:
-  cholmod_sparse* view() {
-    view_.nrow = view_.ncol = static_cast<std::size_t>(a_.rows());
-    view_.nzmax = static_cast<std::size_t>(a_.nonZeros());
-    view_.p = a_.outerIndexPtr();
-    view_.i = a_.innerIndexPtr();
-    view_.x = a_.valuePtr();
-    view_.stype = 1;
-    view_.itype = CHOLMOD_INT;
-    view_.xtype = CHOLMOD_REAL;
-    view_.dtype = CHOLMOD_DOUBLE;
-    view_.sorted = 1;
-    view_.packed = 1;
-    return &view_;
-  }
-  SparseMatrix& a_;
-  cholmod_common common_{};
-  cholmod_sparse view_{};
-  cholmod_factor* factor_ = nullptr;
-};
 
 double relative_difference(const Eigen::MatrixXd& x, const Eigen::MatrixXd& reference) {
   return (x - reference).norm() / reference.norm();
@@ -95,7 +34,7 @@ test::LinearSystem block_system() {
 
 TEST(SupernodalSubstitution, EqualsCholmodSolveWithSubtreesAndLargeTopSupernodes) {
   test::LinearSystem s = block_system();
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   EXPECT_GE(sub.subtree_count(), 2U);
   EXPECT_GE(sub.top_supernode_count(), 1U);
@@ -114,7 +53,7 @@ TEST(SupernodalSubstitution, EqualsCholmodSolveWithSubtreesAndLargeTopSupernodes
 // scheduling-dependent result would change its iteration count from run to run).
 TEST(SupernodalSubstitution, GivesTheSameBitsOnAnyNumberOfThreads) {
   test::LinearSystem s = block_system();
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   const Eigen::MatrixXd all_threads = substituted(sub, chol.factor(), s.b);
   for (int repeat = 0; repeat < 5; ++repeat) EXPECT_TRUE(substituted(sub, chol.factor(), s.b) == all_threads);
@@ -124,7 +63,7 @@ TEST(SupernodalSubstitution, GivesTheSameBitsOnAnyNumberOfThreads) {
 
 TEST(SupernodalSubstitution, KeepsItsScheduleAcrossRefactorizations) {
   test::LinearSystem s = block_system();
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   for (Eigen::Index k = 0; k < s.a.outerSize(); ++k)  // new values, same pattern: K + K's diagonal
     for (SparseMatrix::InnerIterator it(s.a, k); it; ++it)
@@ -135,7 +74,7 @@ TEST(SupernodalSubstitution, KeepsItsScheduleAcrossRefactorizations) {
 
 TEST(SupernodalSubstitution, ForwardThenBackwardIsTheSolve) {
   test::LinearSystem s = block_system();
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   const Eigen::MatrixXd b = Eigen::MatrixXd::Random(s.a.rows(), 4);
   const Eigen::MatrixXd y = sub.forward_of(chol.factor(), b);
@@ -150,7 +89,7 @@ TEST(SupernodalSubstitution, ForwardThenBackwardIsTheSolve) {
 // and only the supernodes above those rows are touched.
 TEST(SupernodalSubstitution, UnitColumnsReachOnlyTheSupernodesAboveThem) {
   test::LinearSystem s = block_system();
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   const Eigen::Index n = s.a.rows();
   const std::vector<Eigen::Index> rows = {n - 1, n - 2, n - 30, n - 31, n - 200, n - 201, n - 202};
@@ -184,14 +123,14 @@ TEST(SupernodalSubstitution, UnitColumnsReachOnlyTheSupernodesAboveThem) {
 TEST(SupernodalSubstitution, SolvesMatricesWithManyRootsAndWithOneSupernode) {
   // Held dofs are identity rows: each is a root of the elimination tree on its own.
   test::LinearSystem clamped = test::clamped_system(test::make_box(Vec3i{6, 3, 3}, 1.0), test::Clamp::both_ends);
-  CholmodFactor chol(clamped.a);
+  test::CholmodFactor chol(clamped.a);
   const SupernodalSubstitution sub(chol.factor());
   EXPECT_LT(relative_difference(substituted(sub, chol.factor(), clamped.b), chol.cholmod_solution(clamped.b)), 1e-12);
 
   SparseMatrix one(1, 1);
   one.insert(0, 0) = 4.0;
   one.makeCompressed();
-  CholmodFactor single(one);
+  test::CholmodFactor single(one);
   const SupernodalSubstitution sub_single(single.factor());
   Eigen::MatrixXd b(1, 2);
   b << 2.0, -8.0;
@@ -202,7 +141,7 @@ TEST(SupernodalSubstitution, SolvesMatricesWithManyRootsAndWithOneSupernode) {
 
 TEST(SupernodalSubstitution, RejectsARightHandSideOfAnotherSize) {
   test::LinearSystem s = test::clamped_system(test::make_box(Vec3i{3, 2, 2}, 1.0), test::Clamp::left_end);
-  CholmodFactor chol(s.a);
+  test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   Eigen::MatrixXd wrong = Eigen::MatrixXd::Ones(s.a.rows() + 1, 1);
   try {
