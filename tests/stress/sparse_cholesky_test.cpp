@@ -134,7 +134,8 @@ TEST(SparseCholeskyUpdate, ConstraintsAddedRemovedAndMovedAreSolvedWithTheKeptFa
 }
 
 // The sparse update (forward-substituted unit columns of the changed rows only, no columns of G
-// kept): the same edits, each the solution of its system, none of them refactorized.
+// kept): the same edits, each the solution of its system, none of them refactorized, each making
+// columns of W only for the changed rows it has none for.
 TEST(SparseCholeskyUpdate, TheSparseUpdateSolvesTheSameEditsWithoutKeepingColumns) {
   const std::vector<int> first = {5, 100, 333, 900, 1500};
   SparseCholesky chol;
@@ -143,13 +144,18 @@ TEST(SparseCholeskyUpdate, TheSparseUpdateSolvesTheSameEditsWithoutKeepingColumn
   chol.factorize(a0);
   Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
   // A stroke-like edit (a row of 60 fresh cells), the constraints moved, one back, the stroke-like
-  // edit again, and once more (as after an undo and a redo: the remembered solution, no solve).
+  // edit again, once more (as after an undo and a redo: the remembered solution, no solve), and
+  // the stroke dragged one cell further (one new column).
   std::vector<int> stroke = first;
+  std::vector<int> dragged = first;
   for (int i = 0; i < 60; ++i) stroke.push_back(kSide * kSide * 6 + kSide * 3 + i);
-  const std::vector<std::vector<int>> edits = {stroke, {6, 101, 334, 901, 1501}, {5, 100, 333, 900, 1500, 6}, stroke, stroke};
-  const std::vector<bool> needs_solves = {true, true, true, true, false};
-  const std::vector<int> sparse_solves = {1, 2, 3, 4, 4};
-  const std::vector<int> remembered = {0, 0, 0, 0, 1};
+  for (int i = 1; i <= 60; ++i) dragged.push_back(kSide * kSide * 6 + kSide * 3 + i);
+  const std::vector<std::vector<int>> edits = {stroke, {6, 101, 334, 901, 1501}, {5, 100, 333, 900, 1500, 6}, stroke, stroke, dragged};
+  const std::vector<bool> needs_solves = {true, true, true, true, false, true};
+  const std::vector<int> sparse_solves = {1, 2, 3, 4, 4, 5};
+  const std::vector<int> remembered = {0, 0, 0, 0, 1, 1};
+  // (The stroke's cells 900 to 959 include a constrained cell, 900, and the moved one, 901.)
+  const std::vector<int> columns_made = {60, 68, 68, 68, 68, 69};
   for (std::size_t e = 0; e < edits.size(); ++e) {
     SCOPED_TRACE(e);
     const Eigen::SparseMatrix<double> a = design_system(kSide, edits[e], kConstraint);
@@ -162,11 +168,43 @@ TEST(SparseCholeskyUpdate, TheSparseUpdateSolvesTheSameEditsWithoutKeepingColumn
     EXPECT_EQ(chol.sparse_update_solves(), sparse_solves[e]);
     EXPECT_EQ(chol.low_rank_solves(), sparse_solves[e]);
     EXPECT_EQ(chol.remembered_solves(), remembered[e]);
+    EXPECT_EQ(chol.sparse_columns_made(), columns_made[e]);
     EXPECT_EQ(chol.last_factor_solves() > 0, needs_solves[e]) << chol.last_factor_solves() << " solves";
     EXPECT_LE(chol.last_factor_solves(), 1 + SparseCholesky::kLowRankRefinementSteps);
     EXPECT_EQ(chol.low_rank_rows(), 0) << "no columns of G are bought";
   }
   EXPECT_EQ(chol.reused_analyses(), 0) << "no refactorization";
+}
+
+// Edits on disjoint sets of rows whose kept columns of W together would exceed kMaxLowRankRows:
+// the kept ones are forgotten (the first rows' columns are made again when they come back) and
+// every edit is the solution of its system.
+TEST(SparseCholeskyUpdate, KeptColumnsOfTheSparseUpdateGiveWayWhenTheyWouldExceedTheBound) {
+  const std::vector<int> first = {0};
+  SparseCholesky chol;
+  chol.set_update_policy(SparseCholesky::UpdatePolicy::sparse);
+  const Eigen::SparseMatrix<double> a0 = design_system(kSide, first, kConstraint);
+  chol.factorize(a0);
+  Eigen::MatrixXd x = chol.solve_refined(a0, targets(kCells, first, kConstraint));
+  const int half = static_cast<int>(SparseCholesky::kMaxLowRankRows) / 2 + 10;
+  ASSERT_LT(2 + 2 * half, kCells);
+  // The first rows, the next ones (too many to keep both), the first ones and one more: without
+  // the first rows' columns forgotten that edit would make one column.
+  const std::vector<int> begins = {1, 1 + half, 1};
+  const std::vector<int> extra = {0, 0, 1};
+  const std::vector<int> columns_made = {half, 2 * half, 3 * half + 1};
+  for (std::size_t e = 0; e < begins.size(); ++e) {
+    SCOPED_TRACE(e);
+    std::vector<int> cells = first;
+    for (int c = begins[e]; c < begins[e] + half + extra[e]; ++c) cells.push_back(c == begins[e] + half ? 1 + 2 * half : c);
+    const Eigen::SparseMatrix<double> a = design_system(kSide, cells, kConstraint);
+    const Eigen::MatrixXd b = targets(kCells, cells, kConstraint);
+    ASSERT_TRUE(chol.solve_with_current_factor(a, b, x, kTolerance, 40));
+    const Eigen::MatrixXd reference = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a).solve(b);
+    EXPECT_LT(relative_error(x, reference), 1e-9);
+    EXPECT_EQ(chol.sparse_columns_made(), columns_made[e]);
+    EXPECT_EQ(chol.sparse_update_solves(), static_cast<int>(e) + 1);
+  }
 }
 
 TEST(SparseCholeskyUpdate, TooManyChangedRowsFallBackToTheCaller) {

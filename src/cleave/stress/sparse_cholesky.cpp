@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cleave/core/error.hpp"
+#include "cleave/solve/forward_column_batches.hpp"
 #include "cleave/solve/supernodal_substitution.hpp"
 
 namespace cleave {
@@ -170,14 +171,11 @@ struct SparseCholesky::Impl {
   Eigen::MatrixXd low_rank_columns;
   std::vector<Eigen::Index> low_rank_row;
   std::vector<Eigen::Index> column_of_row;
-  // Sparse update (UpdatePolicy::sparse): W = L^-1 P E of the changed rows `sparse_rows`, on the
-  // permuted rows `sparse_reached` (where it is not zero), and W^T W = E^T a0^-1 E. Kept while
-  // an edit changes the same rows (a drag back, undo, redo); emptied by every factorization.
-  std::vector<Eigen::Index> sparse_rows;
-  std::vector<Eigen::Index> sparse_reached;
-  Eigen::MatrixXd sparse_w;
-  Eigen::MatrixXd sparse_gram;
-  double sparse_row_seconds = 0;    ///< per changed row, for W and W^T W (0: not measured yet)
+  // Sparse update (UpdatePolicy::sparse): W = L^-1 P E of every row an edit has changed since
+  // the factorization, kept in batches on the rows they reach, and W^T W where edits needed it.
+  // Emptied by every factorization and past kMaxLowRankRows columns or kMaxLowRankBytes.
+  ForwardColumnBatches sparse_columns{static_cast<std::size_t>(SparseCholesky::kMaxLowRankRows), SparseCholesky::kMaxLowRankBytes};
+  double sparse_row_seconds = 0;    ///< per changed row, for its column of W (0: not measured yet)
   double sparse_apply_seconds = 0;  ///< per right-hand side column: the first application of the update
   // The last kRememberedSolutions systems solved with this factor (their diagonal and b: the
   // off-diagonal entries are the factorized ones) and their solutions, newest first.
@@ -248,10 +246,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   impl_->low_rank_columns.resize(0, 0);
   impl_->low_rank_row.clear();
   impl_->column_of_row.assign(static_cast<std::size_t>(a.rows()), -1);
-  impl_->sparse_rows.clear();
-  impl_->sparse_reached.clear();
-  impl_->sparse_w.resize(0, 0);
-  impl_->sparse_gram.resize(0, 0);
+  impl_->sparse_columns.clear();
   impl_->remembered.clear();
 }
 
@@ -413,7 +408,7 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
                                static_cast<Eigen::Index>(changed.size()) <= kMaxLowRankRows &&
                                8.0 * static_cast<double>(n) * static_cast<double>(changed.size()) <= kMaxLowRankBytes;
   if (sparse_possible && policy_ != UpdatePolicy::columns && (policy_ == UpdatePolicy::sparse || !missing_changed.empty())) {
-    const double sparse_seconds = changed == impl.sparse_rows ? sparse_update_seconds(0, b.cols()) : sparse_update_seconds(changed.size(), b.cols());
+    const double sparse_seconds = sparse_update_seconds(impl.sparse_columns.rows_to_make(changed).size(), b.cols());
     const double column_path_seconds =
         static_cast<double>(support_columns) * column_seconds + static_cast<double>(b.cols()) * impl.solve_seconds;
     if (policy_ == UpdatePolicy::sparse ||
@@ -549,29 +544,24 @@ bool SparseCholesky::solve_sparse_update(const Eigen::SparseMatrix<double>& a, c
   Impl& impl = *impl_;
   const cholmod_factor& factor = *impl.llt.factor();
   const SupernodalSubstitution& substitution = *impl.substitution;
-  if (changed != impl.sparse_rows) {
-    const Clock::time_point start = Clock::now();
-    impl.sparse_rows.clear();  // not valid until W and its Gram matrix are made
-    impl.sparse_w = substitution.forward_unit_columns(factor, changed, impl.sparse_reached);
-    impl.sparse_gram.noalias() = impl.sparse_w.transpose() * impl.sparse_w;
-    if (!impl.sparse_gram.allFinite()) return false;
-    impl.sparse_rows = changed;
-    impl.sparse_row_seconds = seconds_between(start, Clock::now()) / static_cast<double>(changed.size());
+  const Clock::time_point start_columns = Clock::now();
+  const int made = impl.sparse_columns.make(substitution, factor, changed);
+  if (made < 0) return false;
+  if (made > 0) {
+    impl.sparse_row_seconds = seconds_between(start_columns, Clock::now()) / static_cast<double>(made);
+    sparse_columns_made_ += made;
   }
-  // a = a0 + E D E^T: a^-1 r = P^T L^-T (y - W Z), y = L^-1 P r, Z = (I + D W^T W)^-1 D W^T y.
+  // This edit's columns of W and their products.
   const auto rank = static_cast<Eigen::Index>(changed.size());
+  const ForwardColumnBatches::Selection w = impl.sparse_columns.select(changed);
   const Eigen::VectorXd d = change(changed);
-  Eigen::MatrixXd capacitance = d.asDiagonal() * impl.sparse_gram;
+  // a = a0 + E D E^T: a^-1 r = P^T L^-T (y - W Z), y = L^-1 P r, Z = (I + D W^T W)^-1 D W^T y.
+  Eigen::MatrixXd capacitance = d.asDiagonal() * w.gram();
   capacitance.diagonal().array() += 1.0;
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
-  const auto& reached = impl.sparse_reached;
   // From y = L^-1 P r: the correction on W's rows, then the back substitution.
   const auto update_and_back = [&](Eigen::MatrixXd y) {
-    Eigen::MatrixXd y_reached(static_cast<Eigen::Index>(reached.size()), y.cols());
-    for (std::size_t i = 0; i < reached.size(); ++i) y_reached.row(static_cast<Eigen::Index>(i)) = y.row(reached[i]);
-    const Eigen::MatrixXd z = lu.solve(d.asDiagonal() * (impl.sparse_w.transpose() * y_reached));
-    y_reached.noalias() = impl.sparse_w * z;
-    for (std::size_t i = 0; i < reached.size(); ++i) y.row(reached[i]) -= y_reached.row(static_cast<Eigen::Index>(i));
+    w.subtract_times(y, lu.solve(d.asDiagonal() * w.transpose_times(y)));
     return substitution.backward_of(factor, std::move(y));
   };
   const auto solve_updated = [&](const Eigen::MatrixXd& r) {

@@ -89,13 +89,17 @@ class SparseCholesky {
   ///    above the changed rows (a stroke's 142 rows reach 13 % of the rows at 45k cells), then
   ///      a^-1 b = P^T L^-T (y - W (I + D W^T W)^-1 D W^T y),   y = L^-1 P b,
   ///    one forward substitution of b (over the supernodes above its rows) and one back
-  ///    substitution (W and W^T W kept while the changed rows stay the same); refined by the same
-  ///    formula. Nothing is kept for later edits on other rows, so a stroke drawn or dragged over
-  ///    fresh cells costs the same as one moved back (docs/stress-design.md, "Sparse update").
+  ///    substitution; refined by the same formula. W's columns are kept for every row changed
+  ///    since the factorization (ForwardColumnBatches: one batch per edit, on the rows it reaches),
+  ///    so an edit makes only its new rows' columns (a stroke dragged one cell further: that
+  ///    cell's) and the products W^T W of pairs no earlier edit used together
+  ///    (docs/stress-design.md, "Sparse update").
   enum class UpdatePolicy { cheaper, columns, sparse };
   void set_update_policy(UpdatePolicy policy) { policy_ = policy; }
   /// Calls of solve_with_current_factor answered by the sparse update (a subset of low_rank_solves).
   int sparse_update_solves() const { return sparse_update_solves_; }
+  /// Columns of W the sparse update has made since construction (each a changed row's first use).
+  int sparse_columns_made() const { return sparse_columns_made_; }
   /// Calls of solve_with_current_factor answered by a remembered solution: the last two systems
   /// solved with this factor (without CG: the factorized matrix or a diagonal change of it) are
   /// kept with their right-hand sides, so that an undo and a redo, or a stroke dragged back and
@@ -118,6 +122,7 @@ class SparseCholesky {
   double sparse_update_seconds(std::size_t rows, Eigen::Index columns) const;
   UpdatePolicy policy_ = UpdatePolicy::cheaper;
   mutable int sparse_update_solves_ = 0;
+  mutable int sparse_columns_made_ = 0;
   mutable int remembered_solves_ = 0;
   int reused_ = 0;
   mutable int last_iterations_ = 0;
