@@ -5,8 +5,10 @@
 
 #include <gtest/gtest.h>
 
+#include <string>
 #include <vector>
 
+#include "cleave/core/error.hpp"
 #include "cleave/solve/supernodal_substitution.hpp"
 #include "cholmod_test_factor.hpp"
 #include "solve_test_systems.hpp"
@@ -94,6 +96,12 @@ TEST(ForwardColumnBatches, KeptColumnsGiveWayPastTheBound) {
   kept.clear();
   EXPECT_EQ(kept.columns(), 0U);
   EXPECT_EQ(kept.rows_to_make(a).size(), 16U);
+  try {
+    (void)kept.select(a);
+    FAIL() << "expected InputError";
+  } catch (const InputError& err) {
+    EXPECT_EQ(std::string(err.what()), "forward column batches: row 10 has no column (make() them first)");
+  }
 }
 
 }  // namespace

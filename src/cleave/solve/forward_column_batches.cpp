@@ -1,8 +1,11 @@
 #include "cleave/solve/forward_column_batches.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <utility>
 
+#include "cleave/core/error.hpp"
 #include "cleave/solve/supernodal_substitution.hpp"
 
 namespace cleave {
@@ -127,7 +130,9 @@ ForwardColumnBatches::Selection ForwardColumnBatches::select(const std::vector<E
   std::vector<std::vector<Eigen::Index>> columns_of_batch(batches_.size());
   std::vector<std::vector<Eigen::Index>> positions_of_batch(batches_.size());
   for (std::size_t i = 0; i < changed.size(); ++i) {
-    const int column = column_of_row_[static_cast<std::size_t>(changed[i])];
+    const Eigen::Index row = changed[i];
+    const int column = row >= 0 && static_cast<std::size_t>(row) < column_of_row_.size() ? column_of_row_[static_cast<std::size_t>(row)] : -1;
+    if (column < 0) throw InputError(fmt::format("forward column batches: row {} has no column (make() them first)", row));
     columns.push_back(column);
     const auto batch = static_cast<std::size_t>(batch_of_column_[static_cast<std::size_t>(column)]);
     columns_of_batch[batch].push_back(column);

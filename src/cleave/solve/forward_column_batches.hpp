@@ -69,7 +69,8 @@ class ForwardColumnBatches {
     Eigen::MatrixXd gram_;
     Eigen::Index size_ = 0;
   };
-  /// This edit's columns; makes the products W^T W of its pairs that are not known yet.
+  /// This edit's columns; makes the products W^T W of its pairs that are not known yet. InputError
+  /// for a row without a column.
   Selection select(const std::vector<Eigen::Index>& changed);
 
  private:
