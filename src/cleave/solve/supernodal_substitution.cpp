@@ -313,20 +313,7 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
   check_order(factor, static_cast<Eigen::Index>(order_));
   if (b_rows.rows() != static_cast<Eigen::Index>(rows.size()))
     throw InputError(fmt::format("supernodal substitution: {} rows of values for {} rows", b_rows.rows(), rows.size()));
-  const auto n = static_cast<Eigen::Index>(order_);
-  // The supernodes reached: each unit column's own and all above it (the rows below a supernode's
-  // columns belong to its ancestors), in elimination order.
-  std::vector<std::uint8_t> reached(supernode_count_, 0);
-  std::vector<int> visit;
-  for (const Eigen::Index r : rows) {
-    if (r < 0 || r >= n) throw InputError(fmt::format("supernodal substitution: unit column row {} is outside 0 to {}", r, n - 1));
-    for (int s = supernode_of_column_[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(r)])];
-         s >= 0 && reached[static_cast<std::size_t>(s)] == 0; s = parent_[static_cast<std::size_t>(s)]) {
-      reached[static_cast<std::size_t>(s)] = 1;
-      visit.push_back(s);
-    }
-  }
-  std::sort(visit.begin(), visit.end());
+  const std::vector<int> visit = supernodes_above(rows);
   // Compact rows: the reached supernodes' columns one after another (each supernode's stay
   // contiguous), and each visited supernode's row indices renumbered to them.
   const auto* super = static_cast<const int*>(factor.super);
@@ -362,6 +349,43 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
       forward_supernode(sn, w, [&](int row, const auto& update) { w.row(row) -= update; });
   }
   return w;
+}
+
+std::vector<int> SupernodalSubstitution::supernodes_above(const std::vector<Eigen::Index>& rows) const {
+  const auto n = static_cast<Eigen::Index>(order_);
+  // Each row's supernode and all above it (the rows below a supernode's columns belong to its
+  // ancestors), in elimination order.
+  std::vector<std::uint8_t> reached(supernode_count_, 0);
+  std::vector<int> visit;
+  for (const Eigen::Index r : rows) {
+    if (r < 0 || r >= n) throw InputError(fmt::format("supernodal substitution: row {} is outside 0 to {}", r, n - 1));
+    for (int s = supernode_of_column_[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(r)])];
+         s >= 0 && reached[static_cast<std::size_t>(s)] == 0; s = parent_[static_cast<std::size_t>(s)]) {
+      reached[static_cast<std::size_t>(s)] = 1;
+      visit.push_back(s);
+    }
+  }
+  std::sort(visit.begin(), visit.end());
+  return visit;
+}
+
+Eigen::MatrixXd SupernodalSubstitution::backward_rows(const cholmod_factor& factor, Eigen::MatrixXd y,
+                                                      const std::vector<Eigen::Index>& rows) const {
+  check_order(factor, y.rows());
+  const std::vector<int> visit = supernodes_above(rows);
+  const double* values = values_of(factor);
+  // From the root down: each supernode reads the rows below its columns, its ancestors', done before it.
+  for (auto it = visit.rbegin(); it != visit.rend(); ++it) {
+    const Supernode sn = supernode_of(factor, values, *it);
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      backward_large_supernode(sn, y);
+    else
+      backward_supernode(sn, y);
+  }
+  Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), y.cols());
+  for (std::size_t i = 0; i < rows.size(); ++i)
+    x.row(static_cast<Eigen::Index>(i)) = y.row(inverse_permutation_[static_cast<std::size_t>(rows[i])]);
+  return x;
 }
 
 }  // namespace cleave

@@ -49,6 +49,10 @@ class SupernodalSubstitution {
   Eigen::MatrixXd forward_of(const cholmod_factor_struct& factor, const Eigen::MatrixXd& b) const;
   /// b = P^T L^-T y (back substitution of a forward-substituted y), on all cores.
   Eigen::MatrixXd backward_of(const cholmod_factor_struct& factor, Eigen::MatrixXd y) const;
+  /// The (unpermuted) rows `rows` of backward_of(factor, y) only: the back substitution over the
+  /// supernodes above those rows (as forward_unit_columns reaches them). Row i of the result is
+  /// row rows[i]. InputError for rows out of range.
+  Eigen::MatrixXd backward_rows(const cholmod_factor_struct& factor, Eigen::MatrixXd y, const std::vector<Eigen::Index>& rows) const;
 
   std::size_t order() const { return order_; }
   /// Independent subtrees solved in parallel, and the supernodes above them.
@@ -74,6 +78,8 @@ class SupernodalSubstitution {
   std::vector<int> supernode_of_column_;
   std::vector<int> inverse_permutation_;  ///< permuted position of each original row
   void check_order(const cholmod_factor_struct& factor, Eigen::Index rows) const;
+  /// The supernodes on the paths from the (unpermuted) rows' supernodes to the roots, ascending.
+  std::vector<int> supernodes_above(const std::vector<Eigen::Index>& rows) const;
 };
 
 }  // namespace cleave
