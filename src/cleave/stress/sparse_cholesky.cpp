@@ -534,7 +534,10 @@ double SparseCholesky::sparse_update_seconds(std::size_t rows, Eigen::Index colu
   const Impl& impl = *impl_;
   const double row_seconds = impl.sparse_row_seconds > 0 ? impl.sparse_row_seconds : kSparseRowShareOfSolve * impl.solve_seconds;
   const double apply_seconds = impl.sparse_apply_seconds > 0 ? impl.sparse_apply_seconds : impl.solve_seconds;
-  // W for the new rows, then the update applied to b and once more to refine it.
+  // W for the new rows, then twice the measured application to b (with its residual correction;
+  // a refinement solve is rare). The weight 2 tunes the choice against buying columns: at 1 the
+  // control points' edits take the sparse update, pay it again at every edit, and the bench's
+  // value_point edit went from 5 to 18-23 ms at 45k cells.
   return static_cast<double>(rows) * row_seconds + 2.0 * static_cast<double>(columns) * apply_seconds;
 }
 
