@@ -132,6 +132,14 @@ void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
   }
 }
 
+/// backward_supernode, on all threads for a large supernode.
+void backward_any_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
+  if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+    backward_large_supernode(sn, y);
+  else
+    backward_supernode(sn, y);
+}
+
 }  // namespace
 
 SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
@@ -246,13 +254,8 @@ void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::Matri
   const double* values = values_of(factor);
   // Backward: the top supernodes from the root down, then the subtrees in parallel (each reads
   // the rows above it, already final, and writes only its own).
-  for (auto it = top_supernodes_.rbegin(); it != top_supernodes_.rend(); ++it) {
-    const Supernode sn = supernode_of(factor, values, *it);
-    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
-      backward_large_supernode(sn, y);
-    else
-      backward_supernode(sn, y);
-  }
+  for (auto it = top_supernodes_.rbegin(); it != top_supernodes_.rend(); ++it)
+    backward_any_supernode(supernode_of(factor, values, *it), y);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t)
@@ -375,13 +378,7 @@ Eigen::MatrixXd SupernodalSubstitution::backward_rows(const cholmod_factor& fact
   const std::vector<int> visit = supernodes_above(rows);
   const double* values = values_of(factor);
   // From the root down: each supernode reads the rows below its columns, its ancestors', done before it.
-  for (auto it = visit.rbegin(); it != visit.rend(); ++it) {
-    const Supernode sn = supernode_of(factor, values, *it);
-    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
-      backward_large_supernode(sn, y);
-    else
-      backward_supernode(sn, y);
-  }
+  for (auto it = visit.rbegin(); it != visit.rend(); ++it) backward_any_supernode(supernode_of(factor, values, *it), y);
   Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), y.cols());
   for (std::size_t i = 0; i < rows.size(); ++i)
     x.row(static_cast<Eigen::Index>(i)) = y.row(inverse_permutation_[static_cast<std::size_t>(rows[i])]);
