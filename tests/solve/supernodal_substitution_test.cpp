@@ -126,6 +126,12 @@ TEST(SupernodalSubstitution, UnitColumnsReachOnlyTheSupernodesAboveThem) {
   } catch (const InputError& err) {
     EXPECT_EQ(std::string(err.what()), fmt::format("supernodal substitution: row {} is outside 0 to {}", n, n - 1));
   }
+  try {
+    (void)sub.backward_rows(chol.factor(), y, {-1});
+    FAIL() << "expected InputError";
+  } catch (const InputError& err) {
+    EXPECT_EQ(std::string(err.what()), fmt::format("supernodal substitution: row -1 is outside 0 to {}", n - 1));
+  }
 }
 
 TEST(SupernodalSubstitution, SolvesMatricesWithManyRootsAndWithOneSupernode) {
