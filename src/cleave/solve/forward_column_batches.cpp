@@ -60,7 +60,6 @@ bool ForwardColumnBatches::overflow(std::size_t added, double added_rows) const 
 void ForwardColumnBatches::clear() {
   bytes_ = 0;
   batches_.clear();
-  row_of_column_.clear();
   batch_of_column_.clear();
   column_of_row_.clear();
   gram_.resize(0, 0);
@@ -91,8 +90,7 @@ int ForwardColumnBatches::make(const SupernodalSubstitution& substitution, const
   const auto added = static_cast<Eigen::Index>(missing.size());
   batch.first_column = kept;
   for (const Eigen::Index r : missing) {
-    column_of_row_[static_cast<std::size_t>(r)] = static_cast<int>(row_of_column_.size());
-    row_of_column_.push_back(r);
+    column_of_row_[static_cast<std::size_t>(r)] = static_cast<int>(batch_of_column_.size());
     batch_of_column_.push_back(static_cast<int>(batches_.size()));
   }
   bytes_ += kBytesPerValue * static_cast<double>(batch.w.size());

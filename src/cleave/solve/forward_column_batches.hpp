@@ -37,7 +37,7 @@ class ForwardColumnBatches {
   /// they are not finite (then nothing is kept).
   int make(const SupernodalSubstitution& substitution, const cholmod_factor_struct& factor, const std::vector<Eigen::Index>& changed);
   void clear();
-  std::size_t columns() const { return row_of_column_.size(); }
+  std::size_t columns() const { return batch_of_column_.size(); }
   std::size_t batches() const { return batches_.size(); }
 
   /// The columns of one edit's changed rows (each must have one), in the order of `changed`.
@@ -92,8 +92,7 @@ class ForwardColumnBatches {
   double max_bytes_;
   double bytes_ = 0;
   std::vector<Batch> batches_;
-  std::vector<Eigen::Index> row_of_column_;
-  std::vector<int> batch_of_column_;
+  std::vector<int> batch_of_column_;  ///< per kept column: its batch
   std::vector<int> column_of_row_;  ///< per row: its column, or -1 (empty until the first batch)
   Eigen::MatrixXd gram_;            ///< W^T W where known_
   Eigen::Matrix<unsigned char, Eigen::Dynamic, Eigen::Dynamic> known_;

@@ -275,11 +275,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       impl_->factor_seconds + static_cast<double>(b.cols()) * (kRefinementSteps + 1) * impl_->solve_seconds;
   if (impl_->same_values(a)) {  // only the right-hand side changed: the factor is exact
     const Eigen::VectorXd a_diagonal = a.diagonal();
-    if (const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b)) {
-      x = *known;
-      ++remembered_solves_;
-      return true;
-    }
+    if (recall(a_diagonal, b, x)) return true;
     // Without a solve when G has a column for every row where b is not zero (a value typed at a
     // control point the last edits placed); otherwise refined as solve_refined does, but only
     // until the tolerance is met (usually one step).
@@ -307,11 +303,7 @@ bool SparseCholesky::solve_with_current_factor(const Eigen::SparseMatrix<double>
       }
   if (diagonal_only) {
     Eigen::VectorXd a_diagonal = a.diagonal();
-    if (const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b)) {
-      x = *known;
-      ++remembered_solves_;
-      return true;
-    }
+    if (recall(a_diagonal, b, x)) return true;
     const Eigen::MatrixXd start = x;
     if (solve_diagonal_update(a, b, x, relative_tolerance, refactor_seconds, true)) {
       impl_->remember(std::move(a_diagonal), b, x);
@@ -530,6 +522,14 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
   return converged;
 }
 
+bool SparseCholesky::recall(const Eigen::VectorXd& a_diagonal, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
+  const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b);
+  if (known == nullptr) return false;
+  x = *known;
+  ++remembered_solves_;
+  return true;
+}
+
 double SparseCholesky::sparse_update_seconds(std::size_t rows, Eigen::Index columns) const {
   const Impl& impl = *impl_;
   const double row_seconds = impl.sparse_row_seconds > 0 ? impl.sparse_row_seconds : kSparseRowShareOfSolve * impl.solve_seconds;
@@ -562,15 +562,13 @@ bool SparseCholesky::solve_sparse_update(const Eigen::SparseMatrix<double>& a, c
   Eigen::MatrixXd capacitance = d.asDiagonal() * w.gram();
   capacitance.diagonal().array() += 1.0;
   const Eigen::PartialPivLU<Eigen::MatrixXd> lu(capacitance);
-  // From y = L^-1 P r: the correction on W's rows, then the back substitution.
+  // y - W Z on W's rows, for y = L^-1 P r.
   const auto update = [&](Eigen::MatrixXd& y) { w.subtract_times(y, lu.solve(d.asDiagonal() * w.transpose_times(y))); };
-  const auto update_and_back = [&](Eigen::MatrixXd y) {
-    update(y);
-    return substitution.backward_of(factor, std::move(y));
-  };
   const auto solve_updated = [&](const Eigen::MatrixXd& r) {
     ++last_factor_solves_;
-    return update_and_back(substitution.forward_of(factor, r));
+    Eigen::MatrixXd y = substitution.forward_of(factor, r);
+    update(y);
+    return substitution.backward_of(factor, std::move(y));
   };
   const Clock::time_point start = Clock::now();
   // b lives on the constrained cells: its forward substitution reaches only the supernodes above them.

@@ -89,7 +89,9 @@ class SparseCholesky {
   ///    above the changed rows (a stroke's 142 rows reach 13 % of the rows at 45k cells), then
   ///      a^-1 b = P^T L^-T (y - W (I + D W^T W)^-1 D W^T y),   y = L^-1 P b,
   ///    one forward substitution of b (over the supernodes above its rows) and one back
-  ///    substitution; refined by the same formula. W's columns are kept for every row changed
+  ///    substitution, before which the residual the update leaves on the changed rows is
+  ///    corrected (x on their neighbours by SupernodalSubstitution::backward_rows); refined by
+  ///    the same formula only if that is not enough. W's columns are kept for every row changed
   ///    since the factorization (ForwardColumnBatches: one batch per edit, on the rows it reaches),
   ///    so an edit makes only its new rows' columns (a stroke dragged one cell further: that
   ///    cell's) and the products W^T W of pairs no earlier edit used together
@@ -118,6 +120,9 @@ class SparseCholesky {
   /// The sparse update (see UpdatePolicy) over the changed rows `changed`, a = a0 + diag(change).
   bool solve_sparse_update(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b, Eigen::MatrixXd& x,
                            double relative_tolerance, const std::vector<Eigen::Index>& changed, const Eigen::VectorXd& change) const;
+  /// x = the remembered solution of the system with this diagonal and b (counted in
+  /// remembered_solves); false when there is none.
+  bool recall(const Eigen::VectorXd& a_diagonal, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const;
   /// Seconds the sparse update of `rows` changed rows and `columns` right-hand sides is expected to take.
   double sparse_update_seconds(std::size_t rows, Eigen::Index columns) const;
   UpdatePolicy policy_ = UpdatePolicy::cheaper;
