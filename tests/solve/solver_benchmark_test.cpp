@@ -9,11 +9,14 @@
 #include <cstdlib>
 #include <string>
 
+#include "cleave/core/allocator_tuning.hpp"
 #include "cleave/fem/lumped_mass.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/multigrid_cg_solver.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
+#include "cleave/solve/supernodal_substitution.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
+#include "cholmod_test_factor.hpp"
 #include "solve_test_systems.hpp"
 
 namespace cleave {
@@ -57,6 +60,29 @@ Systems tube_44k() {
   eliminate_fixed_dofs(s.dynamics.a, s.dynamics.b, fixed);
   s.statics.a.makeCompressed();
   s.dynamics.a.makeCompressed();
+  return s;
+}
+
+TissueModel abdomen_126() {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(126, 41, 84);
+  Material m;
+  m.youngs_modulus_kPa = test::kTissueE_kPa;
+  m.poisson_ratio = test::kTissueNu;
+  return make_tissue_model("abdomen", make_builtin_shape("abdomen", resolution), {{Label{1}, m}});
+}
+
+/// The statics of `model` held at its lowest x, a uniform load along x.
+test::LinearSystem held_at_lowest_x(const TissueModel& model) {
+  const LinkedVolume& volume = model.volume;
+  std::vector<VertexId> held;
+  Vector f = Vector::Constant(3 * volume.vertex_count(), kLoad_mN);
+  const double x0 = volume.grid().origin_mm.x() + volume.grid().cell_size_mm;
+  for (VertexId v = 0; v < volume.vertex_count(); ++v)
+    if (volume.vertex_position_mm(v).x() < x0 + 1e-9) held.push_back(v);
+  test::LinearSystem s{assemble_stiffness(model), f};
+  eliminate_fixed_dofs(s.a, s.b, fix_vertices(volume.vertex_count(), held));
+  s.a.makeCompressed();
   return s;
 }
 
@@ -148,6 +174,36 @@ TEST(SolverBenchmark, DISABLED_Tube44kStaticAndNewmarkStep) {
   std::fflush(stdout);
   run("static ", s.statics, s.model.volume);
   run("newmark", s.dynamics, s.model.volume);
+}
+
+// The substitutions with a kept supernodal factor (the studio's preview and equilibration solve
+// one column per edit, the direction field six): forward and back substitution timed apart, for
+// one and for six columns, against cholmod_solve, on the statics of the 44k tube.
+TEST(SolverBenchmark, DISABLED_Tube44kSubstitution) {
+  keep_freed_memory_for_reuse();  // as the CLI does: no page faults for the repeated arrays
+  Systems s = tube_44k();
+  if (const char* shape = std::getenv("CLEAVE_BENCH_SHAPE"); shape != nullptr && std::string(shape) == "abdomen") {
+    s.model = abdomen_126();
+    s.statics = held_at_lowest_x(s.model);
+  }
+  test::CholmodFactor factor(s.statics.a);
+  const SupernodalSubstitution substitution(factor.factor());
+  const double factor_mb = static_cast<double>(factor.factor().xsize) * 8.0 / 1e6;
+  std::printf("tube 42x42x51 statics: %lld rows, factor %.0f MB\n", static_cast<long long>(s.statics.a.rows()), factor_mb);
+  const char* repeat_env = std::getenv("CLEAVE_BENCH_REPEAT");  // more repeats for a profiler
+  const int kRepeat = repeat_env != nullptr ? std::max(1, std::atoi(repeat_env)) : 9;
+  for (const Eigen::Index columns : {Eigen::Index{1}, Eigen::Index{6}}) {
+    Eigen::MatrixXd b(s.statics.b.size(), columns);
+    for (Eigen::Index c = 0; c < columns; ++c) b.col(c) = (1.0 + 0.1 * static_cast<double>(c)) * s.statics.b;
+    Eigen::MatrixXd y, x;
+    const double forward = best_ms(kRepeat, [&] { y = substitution.forward_of(factor.factor(), b); });
+    const double backward = best_ms(kRepeat, [&] { x = substitution.backward_of(factor.factor(), y); });
+    Eigen::MatrixXd reference;
+    const double cholmod = best_ms(kRepeat, [&] { reference = factor.cholmod_solution(b); });
+    std::printf("  %lld column(s): forward %7.2f ms (%5.1f GB/s), backward %7.2f ms (%5.1f GB/s), cholmod_solve %7.2f ms\n",
+                static_cast<long long>(columns), forward, factor_mb / forward, backward, factor_mb / backward, cholmod);
+    EXPECT_LT((x - reference).norm(), 1e-10 * reference.norm());
+  }
 }
 
 }  // namespace

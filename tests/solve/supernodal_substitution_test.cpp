@@ -48,6 +48,20 @@ TEST(SupernodalSubstitution, EqualsCholmodSolveWithSubtreesAndLargeTopSupernodes
   EXPECT_LT(relative_difference(substituted(sub, chol.factor(), several), chol.cholmod_solution(several)), 1e-12);
 }
 
+// Two to eight columns take the narrow kernels on rows (narrow_panel_kernels.hpp), one and nine
+// Eigen's products: every count agrees with cholmod_solve, through the blocked large supernodes.
+TEST(SupernodalSubstitution, EqualsCholmodSolveForOneToNineColumns) {
+  test::LinearSystem s = block_system();
+  test::CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  for (Eigen::Index columns = 1; columns <= 9; ++columns) {
+    const Eigen::MatrixXd b = Eigen::MatrixXd::Random(s.a.rows(), columns);
+    EXPECT_LT(relative_difference(substituted(sub, chol.factor(), b), chol.cholmod_solution(b)), 1e-12) << columns << " columns";
+    const Eigen::MatrixXd y = sub.forward_of(chol.factor(), b);
+    EXPECT_LT(relative_difference(sub.backward_of(chol.factor(), y), chol.cholmod_solution(b)), 1e-12) << columns << " columns";
+  }
+}
+
 // The same schedule gives the same bits however the threads share the work: repeated solves,
 // and a solve on one thread (the equilibration's stopping test sits near rounding, so a
 // scheduling-dependent result would change its iteration count from run to run).
@@ -57,8 +71,11 @@ TEST(SupernodalSubstitution, GivesTheSameBitsOnAnyNumberOfThreads) {
   const SupernodalSubstitution sub(chol.factor());
   const Eigen::MatrixXd all_threads = substituted(sub, chol.factor(), s.b);
   for (int repeat = 0; repeat < 5; ++repeat) EXPECT_TRUE(substituted(sub, chol.factor(), s.b) == all_threads);
+  const Eigen::MatrixXd six = Eigen::MatrixXd::Random(s.a.rows(), 6);  // the narrow kernels' reductions too
+  const Eigen::MatrixXd six_all_threads = substituted(sub, chol.factor(), six);
   const tbb::global_control one_thread(tbb::global_control::max_allowed_parallelism, 1);
   EXPECT_TRUE(substituted(sub, chol.factor(), s.b) == all_threads);
+  EXPECT_TRUE(substituted(sub, chol.factor(), six) == six_all_threads);
 }
 
 TEST(SupernodalSubstitution, KeepsItsScheduleAcrossRefactorizations) {

@@ -14,6 +14,7 @@
 #include <utility>
 
 #include "cleave/core/error.hpp"
+#include "cleave/solve/narrow_panel_kernels.hpp"
 
 namespace cleave {
 namespace {
@@ -29,6 +30,8 @@ constexpr Eigen::Index kColumnBlock = 128;
 constexpr Eigen::Index kChunkEntries = Eigen::Index{1} << 15;
 
 using ConstMatrixMap = Eigen::Map<const Eigen::MatrixXd>;
+/// Right-hand sides stored by rows (narrow_panel_kernels.hpp).
+using RhsRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// One supernode of a CHOLMOD factor: columns [first, first + columns) of L, stored as a dense
 /// column-major rows x columns block whose row i is permuted row row_index[i] (the first
@@ -57,13 +60,27 @@ const double* values_of(const cholmod_factor& f) { return static_cast<const doub
 /// Rows to give one parallel chunk of a panel `width` columns wide.
 Eigen::Index chunk_rows(Eigen::Index width) { return std::max<Eigen::Index>(64, kChunkEntries / std::max<Eigen::Index>(width, 1)); }
 
+/// t y = y for a triangle t (a triangularView of a diagonal block) and the rows y of one or more
+/// right-hand sides. A single column takes Eigen's vector solve: its matrix solve packs the
+/// triangle anew at every call, which made the forward substitution of one column twice as slow
+/// as the backward one.
+template <typename Triangle, typename Rows>
+void solve_in_place(const Triangle& t, Rows&& y) {
+  if (y.cols() == 1) {
+    auto column = y.col(0);
+    t.solveInPlace(column);
+  } else {
+    t.solveInPlace(y);
+  }
+}
+
 /// L11 y1 = y1, then y(rows below) -= L21 y1: subtract_below(row, update) applies the update of
 /// one permuted row below the diagonal block. One thread.
 template <typename Subtract>
 void forward_supernode(const Supernode& sn, Eigen::MatrixXd& y, const Subtract& subtract_below) {
   const ConstMatrixMap l = sn.block();
   auto y1 = y.middleRows(sn.first, sn.columns);
-  l.topRows(sn.columns).triangularView<Eigen::Lower>().solveInPlace(y1);
+  solve_in_place(l.topRows(sn.columns).triangularView<Eigen::Lower>(), y1);
   const Eigen::Index below = sn.rows - sn.columns;
   if (below == 0) return;
   const Eigen::MatrixXd update = l.bottomRows(below) * y1;
@@ -80,7 +97,7 @@ void backward_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
     for (Eigen::Index i = 0; i < below; ++i) gathered.row(i) = y.row(sn.row_index[sn.columns + i]);
     y1.noalias() -= l.bottomRows(below).transpose() * gathered;
   }
-  l.topRows(sn.columns).triangularView<Eigen::Lower>().transpose().solveInPlace(y1);
+  solve_in_place(l.topRows(sn.columns).triangularView<Eigen::Lower>().transpose(), y1);
 }
 
 /// forward_supernode of a large supernode: column blocks, the rows below each over all threads.
@@ -89,7 +106,7 @@ void forward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
   for (Eigen::Index j0 = 0; j0 < sn.columns; j0 += kColumnBlock) {
     const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
     auto yj = y.middleRows(sn.first + j0, width);
-    l.block(j0, j0, width, width).triangularView<Eigen::Lower>().solveInPlace(yj);
+    solve_in_place(l.block(j0, j0, width, width).triangularView<Eigen::Lower>(), yj);
     const Eigen::Index begin = j0 + width;
     if (begin == sn.rows) continue;
     const Eigen::MatrixXd yj_copy = yj;  // read by every chunk while they write other rows of y
@@ -128,7 +145,7 @@ void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
           tbb::simple_partitioner());
       yj -= product;
     }
-    l.block(j0, j0, width, width).triangularView<Eigen::Lower>().transpose().solveInPlace(yj);
+    solve_in_place(l.block(j0, j0, width, width).triangularView<Eigen::Lower>().transpose(), yj);
   }
 }
 
@@ -138,6 +155,142 @@ void backward_any_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
     backward_large_supernode(sn, y);
   else
     backward_supernode(sn, y);
+}
+
+/// The supernode steps with Eigen's dense products: any number of columns (the sparse updates'
+/// hundreds of unit columns; one column takes Eigen's vector kernels).
+struct WideKernels {
+  using Matrix = Eigen::MatrixXd;
+  template <typename Subtract>
+  static void forward(const Supernode& sn, Matrix& y, const Subtract& subtract_below) {
+    forward_supernode(sn, y, subtract_below);
+  }
+  static void forward_large(const Supernode& sn, Matrix& y) { forward_large_supernode(sn, y); }
+  static void backward(const Supernode& sn, Matrix& y) { backward_supernode(sn, y); }
+  static void backward_any(const Supernode& sn, Matrix& y) { backward_any_supernode(sn, y); }
+};
+
+/// The same steps for K = 2 to 8 columns stored by rows, with the kernels of
+/// narrow_panel_kernels.hpp (they read the factor without copying it first).
+template <int K>
+struct NarrowKernels {
+  using Matrix = RhsRows;
+  using Row = Eigen::Map<const Eigen::Matrix<double, 1, K>>;
+
+  /// y(rows[i], c) for i < count as count x K by columns: g[c * count + i].
+  static void gather_columns(const Matrix& y, const int* rows, Eigen::Index count, std::vector<double>& g) {
+    g.resize(static_cast<std::size_t>(count * K));
+    for (Eigen::Index i = 0; i < count; ++i) {
+      const double* row = y.data() + Eigen::Index{rows[i]} * K;
+      for (int c = 0; c < K; ++c) g[static_cast<std::size_t>(c * count + i)] = row[c];
+    }
+  }
+
+  template <typename Subtract>
+  static void forward(const Supernode& sn, Matrix& y, const Subtract& subtract_below) {
+    double* y1 = y.data() + sn.first * K;
+    lower_solve_rows<K>(sn.entries, sn.rows, sn.columns, y1);
+    const Eigen::Index below = sn.rows - sn.columns;
+    if (below == 0) return;
+    thread_local std::vector<double> update;
+    update.resize(static_cast<std::size_t>(below * K));
+    panel_times_rows<K>(sn.entries + sn.columns, sn.rows, below, sn.columns, y1, update.data());
+    for (Eigen::Index i = 0; i < below; ++i) subtract_below(sn.row_index[sn.columns + i], Row(update.data() + i * K));
+  }
+
+  static void forward_large(const Supernode& sn, Matrix& y) {
+    for (Eigen::Index j0 = 0; j0 < sn.columns; j0 += kColumnBlock) {
+      const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
+      double* yj = y.data() + (sn.first + j0) * K;
+      const double* panel = sn.entries + j0 * sn.rows;  // columns j0 .. j0 + width, from row 0
+      lower_solve_rows<K>(panel + j0, sn.rows, width, yj);
+      const Eigen::Index begin = j0 + width;
+      if (begin == sn.rows) continue;
+      // The chunks read yj and write other rows of y (the rows below the supernode's columns).
+      tbb::parallel_for(tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)),
+                        [&](const tbb::blocked_range<Eigen::Index>& range) {
+                          const Eigen::Index count = range.end() - range.begin();
+                          thread_local std::vector<double> update;
+                          update.resize(static_cast<std::size_t>(count * K));
+                          panel_times_rows<K>(panel + range.begin(), sn.rows, count, width, yj, update.data());
+                          for (Eigen::Index i = 0; i < count; ++i)
+                            y.row(sn.row_index[range.begin() + i]) -= Row(update.data() + i * K);
+                        });
+    }
+  }
+
+  static void backward(const Supernode& sn, Matrix& y) {
+    double* y1 = y.data() + sn.first * K;
+    const Eigen::Index below = sn.rows - sn.columns;
+    if (below > 0) {
+      thread_local std::vector<double> gathered, product;
+      gather_columns(y, sn.row_index + sn.columns, below, gathered);
+      product.resize(static_cast<std::size_t>(sn.columns * K));
+      panel_transpose_times<K>(sn.entries + sn.columns, sn.rows, below, sn.columns, gathered.data(), product.data());
+      for (Eigen::Index i = 0; i < sn.columns * K; ++i) y1[i] -= product[static_cast<std::size_t>(i)];
+    }
+    upper_solve_rows<K>(sn.entries, sn.rows, sn.columns, y1);
+  }
+
+  static void backward_large(const Supernode& sn, Matrix& y) {
+    const Eigen::Index blocks = (sn.columns + kColumnBlock - 1) / kColumnBlock;
+    for (Eigen::Index b = blocks - 1; b >= 0; --b) {
+      const Eigen::Index j0 = b * kColumnBlock;
+      const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
+      double* yj = y.data() + (sn.first + j0) * K;
+      const double* panel = sn.entries + j0 * sn.rows;
+      const Eigen::Index begin = j0 + width;
+      if (begin < sn.rows) {
+        // Deterministic: the chunks and their summation order do not depend on the scheduling.
+        const Eigen::VectorXd product = tbb::parallel_deterministic_reduce(
+            tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)), Eigen::VectorXd::Zero(width * K).eval(),
+            [&](const tbb::blocked_range<Eigen::Index>& range, Eigen::VectorXd sum) {
+              const Eigen::Index count = range.end() - range.begin();
+              thread_local std::vector<double> gathered;
+              gather_columns(y, sn.row_index + range.begin(), count, gathered);
+              Eigen::VectorXd part(width * K);
+              panel_transpose_times<K>(panel + range.begin(), sn.rows, count, width, gathered.data(), part.data());
+              sum += part;
+              return sum;
+            },
+            [](const Eigen::VectorXd& a, const Eigen::VectorXd& c) -> Eigen::VectorXd { return a + c; },
+            tbb::simple_partitioner());
+        for (Eigen::Index i = 0; i < width * K; ++i) yj[i] -= product[i];
+      }
+      upper_solve_rows<K>(panel + j0, sn.rows, width, yj);
+    }
+  }
+
+  static void backward_any(const Supernode& sn, Matrix& y) {
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      backward_large(sn, y);
+    else
+      backward(sn, y);
+  }
+};
+
+/// fn(NarrowKernels<K>{}, rows) on a copy of y stored by rows when y has 2 to 8 columns, the
+/// result copied back; false (y untouched) for other column counts.
+template <int K, typename Fn>
+bool run_by_rows(Eigen::MatrixXd& y, const Fn& fn) {
+  RhsRows rows = y;
+  fn(NarrowKernels<K>{}, rows);
+  y = rows;
+  return true;
+}
+
+template <typename Fn>
+bool run_narrow(Eigen::MatrixXd& y, const Fn& fn) {
+  switch (y.cols()) {
+    case 2: return run_by_rows<2>(y, fn);
+    case 3: return run_by_rows<3>(y, fn);
+    case 4: return run_by_rows<4>(y, fn);
+    case 5: return run_by_rows<5>(y, fn);
+    case 6: return run_by_rows<6>(y, fn);
+    case 7: return run_by_rows<7>(y, fn);
+    case 8: return run_by_rows<8>(y, fn);
+    default: return false;
+  }
 }
 
 }  // namespace
@@ -215,18 +368,30 @@ SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
 }
 
 void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
+  const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) { forward_with<decltype(kernels)>(factor, rows); });
+  if (!narrow) forward_with<WideKernels>(factor, y);
+}
+
+void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
+  const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) { backward_with<decltype(kernels)>(factor, rows); });
+  if (!narrow) backward_with<WideKernels>(factor, y);
+}
+
+template <typename Kernels>
+void SupernodalSubstitution::forward_with(const cholmod_factor& factor, typename Kernels::Matrix& y) const {
+  using Matrix = typename Kernels::Matrix;
   const double* values = values_of(factor);
   // Forward: the subtrees in parallel; each one's updates of the rows above it go to its own
   // sums, subtracted in subtree order before the top supernodes run (the same rounding whatever
   // thread ran which subtree).
   const auto top_rows = static_cast<Eigen::Index>(row_of_top_slot_.size());
-  std::vector<Eigen::MatrixXd> above(subtree_count());
+  std::vector<Matrix> above(subtree_count());
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
-                        Eigen::MatrixXd& sums = above[t];  // made at its first update: a root (a held dof) has none
+                        Matrix& sums = above[t];  // made at its first update: a root (a held dof) has none
                         for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i)
-                          forward_supernode(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
+                          Kernels::forward(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
                             const int slot = top_slot_of_row_[static_cast<std::size_t>(row)];
                             if (slot >= 0) {
                               if (sums.size() == 0) sums.setZero(top_rows, y.cols());
@@ -238,29 +403,30 @@ void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::Matrix
                       }
                     },
                     tbb::simple_partitioner());
-  for (const Eigen::MatrixXd& sums : above)
+  for (const Matrix& sums : above)
     if (sums.size() > 0)
       for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
   for (const int s : top_supernodes_) {
     const Supernode sn = supernode_of(factor, values, s);
     if (sn.rows * sn.columns >= kParallelSupernodeEntries)
-      forward_large_supernode(sn, y);
+      Kernels::forward_large(sn, y);
     else
-      forward_supernode(sn, y, [&](int row, const auto& update) { y.row(row) -= update; });
+      Kernels::forward(sn, y, [&](int row, const auto& update) { y.row(row) -= update; });
   }
 }
 
-void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
+template <typename Kernels>
+void SupernodalSubstitution::backward_with(const cholmod_factor& factor, typename Kernels::Matrix& y) const {
   const double* values = values_of(factor);
   // Backward: the top supernodes from the root down, then the subtrees in parallel (each reads
   // the rows above it, already final, and writes only its own).
   for (auto it = top_supernodes_.rbegin(); it != top_supernodes_.rend(); ++it)
-    backward_any_supernode(supernode_of(factor, values, *it), y);
+    Kernels::backward_any(supernode_of(factor, values, *it), y);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, subtree_count(), 1),
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t)
                         for (std::size_t i = subtree_begin_[t + 1]; i-- > subtree_begin_[t];)
-                          backward_supernode(supernode_of(factor, values, subtree_order_[i]), y);
+                          Kernels::backward(supernode_of(factor, values, subtree_order_[i]), y);
                     },
                     tbb::simple_partitioner());
 }

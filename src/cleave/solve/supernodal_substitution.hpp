@@ -64,6 +64,12 @@ class SupernodalSubstitution {
   void forward(const cholmod_factor_struct& factor, Eigen::MatrixXd& y) const;
   /// L^T y = y.
   void backward(const cholmod_factor_struct& factor, Eigen::MatrixXd& y) const;
+  /// forward and backward with the supernode steps of `Kernels` (Eigen's products, or the
+  /// narrow kernels on right-hand sides stored by rows); defined and used in the .cpp only.
+  template <typename Kernels>
+  void forward_with(const cholmod_factor_struct& factor, typename Kernels::Matrix& y) const;
+  template <typename Kernels>
+  void backward_with(const cholmod_factor_struct& factor, typename Kernels::Matrix& y) const;
 
   std::size_t order_ = 0;
   std::size_t supernode_count_ = 0;
