@@ -79,6 +79,35 @@ TEST(StaticSolver, SetUpOnAnotherThreadThenSolvedHereEqualsAFreshSolve) {
   EXPECT_EQ(statics.solves(), 1);
 }
 
+// Undo, redo and a drag back in the studio solve the preview again with a stress equal to one of
+// the last two: answered from memory, equal to the first solve, with no solve; a third stress
+// pushes the oldest out.
+TEST(StaticSolver, TheLastTwoStressesAreAnsweredWithoutASolve) {
+  const TissueModel model = test::make_box_model({6, 3, 3}, 2.0);
+  StaticOptions options;
+  options.solver = SolverKind::cholmod;
+  options.fixed_vertices = vertices_in_box(model.volume, Vec3(-0.1, -1, -1), Vec3(0.1, 7, 7));
+  StaticSolver statics(model, options);
+  const std::vector<Vec6> a = graded_stress(model.volume, 10.0);
+  const std::vector<Vec6> b = graded_stress(model.volume, -4.0);
+  const std::vector<Vec6> c = graded_stress(model.volume, 2.5);
+  const StaticResult first_a = statics.solve(a);
+  const StaticResult first_b = statics.solve(b);
+  EXPECT_FALSE(first_a.remembered);
+  const StaticResult again_a = statics.solve(a);
+  const StaticResult again_b = statics.solve(b);
+  EXPECT_TRUE(again_a.remembered);
+  EXPECT_TRUE(again_b.remembered);
+  EXPECT_TRUE(again_a.displacement_mm == first_a.displacement_mm);
+  EXPECT_TRUE(again_b.displacement_mm == first_b.displacement_mm);
+  EXPECT_EQ(statics.solves(), 2);
+  (void)statics.solve(c);  // remembered now: c and b
+  const StaticResult third_a = statics.solve(a);
+  EXPECT_FALSE(third_a.remembered);
+  EXPECT_EQ(statics.solves(), 4);
+  EXPECT_LT(max_difference_mm(third_a.displacement_mm, first_a.displacement_mm), 1e-12 * max_norm_mm(first_a.displacement_mm));
+}
+
 TEST(StaticSolver, NoLoadNeedsNoSolveAndMovesNothing) {
   const TissueModel model = test::make_box_model({3, 3, 3}, 2.0);
   StaticOptions options;

@@ -208,6 +208,44 @@ TEST(Equilibration, EditsLearnTheSoftModesAndEqualAFreshEquilibration) {
   EXPECT_LE(late_solves, (kRounds - 1) * 3 + 1);
 }
 
+// Undo, redo and a stroke dragged back give a design equal to one of the last two, bit for bit:
+// answered from memory with no solve, the same field as before; a new design after that starts
+// from the recalled design's displacement and still equals a fresh equilibration.
+TEST(Equilibration, TheLastTwoDesignsAreAnsweredWithoutASolve) {
+  const TissueModel m = test::builtin_model("abdomen");
+  const Vec3 c = m.volume.grid().origin_mm + 0.5 * m.volume.grid().extent_mm();
+  const std::vector<Vec6> a = spotted_design_kPa(m, c + Vec3(-30.0, 5.0, 0.0));
+  const std::vector<Vec6> b = spotted_design_kPa(m, c + Vec3(0.0, -5.0, 3.0));
+  const std::vector<Vec6> third = spotted_design_kPa(m, c + Vec3(25.0, 0.0, -3.0));
+  StressEquilibrator kept(m);
+  const EquilibrationResult first_a = kept.equilibrate(a);
+  const EquilibrationResult first_b = kept.equilibrate(b);
+  ASSERT_GT(first_a.refinement_steps, 0);
+  ASSERT_GT(first_b.refinement_steps, 0);
+  for (int round = 0; round < 2; ++round) {
+    const EquilibrationResult again_a = kept.equilibrate(a);
+    EXPECT_EQ(again_a.refinement_steps, 0);
+    EXPECT_TRUE(again_a.stress_kPa == first_a.stress_kPa);
+    EXPECT_EQ(again_a.force_reduction, first_a.force_reduction);
+    const EquilibrationResult again_b = kept.equilibrate(b);
+    EXPECT_EQ(again_b.refinement_steps, 0);
+    EXPECT_TRUE(again_b.stress_kPa == first_b.stress_kPa);
+  }
+  std::vector<Vec6> nudged = a;  // one cell's tensor one ulp off: a new design, solved
+  nudged[0][0] = std::nextafter(nudged[0][0], 1e300);
+  EXPECT_GT(kept.equilibrate(nudged).refinement_steps, 0);
+
+  const EquilibrationResult edited = kept.equilibrate(third);
+  const std::vector<Vec6> fresh = equilibrate_stress(m, third).stress_kPa;
+  EXPECT_GT(edited.refinement_steps, 0);
+  double difference = 0, largest = 0;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    difference = std::max(difference, (edited.stress_kPa[i] - fresh[i]).cwiseAbs().maxCoeff());
+    largest = std::max(largest, fresh[i].cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(difference, 1e-8 * largest);
+}
+
 TEST(Equilibration, ABalancedFieldIsLeftAsItIs) {
   const TissueModel m = test::builtin_model("plate", {Vec3i(8, 8, 2), std::nullopt});
   const std::vector<Vec6> zero(static_cast<std::size_t>(m.volume.cell_count()), Vec6::Zero());

@@ -37,6 +37,7 @@ struct StaticResult {
   SolveReport report;                 ///< iterations 0 when no solve was needed (zero load)
   std::string solver_name;
   int free_components = 0;            ///< pieces that no fixed vertex held
+  bool remembered = false;            ///< StaticSolver: an earlier solve's result for the same stress (no solve)
 };
 
 StaticResult solve_static(const TissueModel& model, std::span<const Vec6> residual_stress_kPa,

@@ -12,6 +12,7 @@
 #include <memory>
 #include <span>
 
+#include "cleave/core/recent_results.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/rigid_supports.hpp"
 #include "cleave/fem/solve_static.hpp"
@@ -26,7 +27,9 @@ class StaticSolver {
   StaticSolver(const TissueModel& model, SparseMatrix stiffness, const StaticOptions& options);
 
   /// Solves K u = f - T sigma (f: the options' external force) as solve_static does; the solver
-  /// is set up at the first loaded solve and kept. Throws as solve_static.
+  /// is set up at the first loaded solve and kept. A stress equal (bit for bit) to one of the
+  /// last two solved is answered from memory (`remembered` set, no solve: undo, redo, a drag
+  /// back in the studio). Throws as solve_static.
   StaticResult solve(std::span<const Vec6> residual_stress_kPa);
 
   /// Sets the linear solver up now (a CHOLMOD factorization, a multigrid hierarchy) instead of at
@@ -34,10 +37,13 @@ class StaticSolver {
   /// the first solve costs one solve. Does nothing when it is set up.
   void set_up_solver();
 
-  int solves() const { return solves_; }  ///< loaded solves done
+  int solves() const { return solves_; }  ///< loaded solves done (not the remembered answers)
   bool set_up() const { return set_up_; }
 
  private:
+  static constexpr std::size_t kRememberedLoads = 2;
+  StaticResult solve_anew(std::span<const Vec6> residual_stress_kPa);
+
   const TissueModel& model_;
   StaticOptions options_;
   SparseMatrix eliminated_;  ///< K with the held dofs' rows and columns replaced by identity
@@ -47,6 +53,7 @@ class StaticSolver {
   std::unique_ptr<LinearSolver> solver_;
   bool set_up_ = false;
   int solves_ = 0;
+  RecentResults<Vec6, StaticResult> recent_{kRememberedLoads};
 };
 
 }  // namespace cleave

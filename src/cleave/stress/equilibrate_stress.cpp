@@ -8,6 +8,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/core/recent_results.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/fem/hex8_element.hpp"
 #include "cleave/fem/residual_stress_forces.hpp"
@@ -37,6 +38,7 @@ constexpr double kStallReduction = 5e-11;
 constexpr double kRequiredReduction = 1e-10;  ///< ComputeError above this at the end
 constexpr int kMaxIterations = 200;
 constexpr Eigen::Index kMaxSoftModes = 16;  ///< soft modes kept (2 x 16 vectors: 40 MB at 156,000 dofs)
+constexpr std::size_t kRememberedDesigns = 2;  ///< an edit and the one before it (undo, redo, a drag back)
 constexpr double kNewSoftMode = 1e-6;      ///< a correction adds a mode when this share of its energy is new
 constexpr double kDependentDirection = 1e-12;  ///< relative eigenvalue of the scaled Gram matrix below which a direction is dropped
 
@@ -55,6 +57,12 @@ struct StressEquilibrator::Impl {
   Eigen::MatrixXd kc_soft_modes;
   bool factorized = false;
   Vector u;  ///< displacement of the last solve (warm start)
+  /// The last designs' results and displacements: a design seen again needs no solve.
+  struct Known {
+    EquilibrationResult result;
+    Vector u;
+  };
+  RecentResults<Vec6, Known> recent{kRememberedDesigns};
   std::vector<std::uint8_t> held_dof;  ///< per dof: 1 = vertex held (Gamma_D)
 
   Impl(const TissueModel& m, std::span<const VertexId> held_vertices)
@@ -245,6 +253,12 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
   for (std::size_t c = 0; c < designed_kPa.size(); ++c)
     if (!designed_kPa[c].allFinite()) throw InputError(fmt::format("designed stress of cell {} is not finite", c));
 
+  if (const Impl::Known* known = impl_->recent.find(designed_kPa)) {
+    impl_->u = known->u;  // the next edit starts from this design's displacement, as after a solve
+    EquilibrationResult recalled = known->result;
+    recalled.refinement_steps = 0;
+    return recalled;
+  }
   EquilibrationResult result;
   result.stress_kPa.assign(designed_kPa.begin(), designed_kPa.end());
   Vector load = residual_stress_forces(volume, designed_kPa);
@@ -281,6 +295,7 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
                                    "preconditioned CG iterations (required {:.0e})",
                                    result.force_reduction, result.refinement_steps, kRequiredReduction));
   }
+  impl_->recent.remember(designed_kPa, Impl::Known{result, impl_->u});
   return result;
 }
 

@@ -22,7 +22,8 @@
 // Edits: each solve starts from the last displacement, and its first step minimizes the energy
 // over the factor's correction and the soft modes learned from earlier solves (what CG corrected
 // after its first step, Kc-orthonormal, at most 16): an edit back to an earlier design (a drag
-// back and forth, undo, redo) needs one solve with the factor instead of two to four.
+// back and forth, undo, redo) needs one solve with the factor instead of two to four; and a design
+// equal to one of the last two (bit for bit) is answered from memory with no solve at all.
 // Consequences: the uncut, unsupported body does not move under sigma, and the volume average of
 // sigma is exactly zero (Hoger's theorem, section 3.1), since T sigma = 0 for a field on cubes
 // implies sum_c V sigma_c = 0.
@@ -41,7 +42,7 @@ namespace cleave {
 struct EquilibrationResult {
   std::vector<Vec6> stress_kPa;         ///< self-balanced field, one per cell
   double force_reduction = 0;           ///< ||T sigma|| / ||T sigma_d|| over free vertices (0 when sigma_d was balanced)
-  int refinement_steps = 0;             ///< solves with the factor (preconditioned CG iterations)
+  int refinement_steps = 0;             ///< solves with the factor (preconditioned CG iterations); 0 when remembered
 };
 
 class StressEquilibrator {
@@ -58,7 +59,7 @@ class StressEquilibrator {
   /// Throws InputError when `designed_kPa` has the wrong size or non-finite values; ComputeError
   /// when ||T sigma|| / ||T sigma_d|| stays above 1e-10 (never returns NaN). Starts from the
   /// displacement of the previous call and the soft modes of the earlier ones (a small edit
-  /// needs one or two solves with the factor).
+  /// needs one or two solves with the factor; one of the last two designs, none).
   EquilibrationResult equilibrate(std::span<const Vec6> designed_kPa);
 
  private:
