@@ -11,7 +11,10 @@
 //   equilibrate  making the designed stress exactly self-balanced
 //   preview      one incision-preview solve: statics of the body with round incisions cut
 //   step         one implicit corotational Newmark step during an ongoing cut
-//   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface
+//   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface;
+//                stroke 0 moves among three positions in turn (vector, value and equilibrate are
+//                timed in the same edits): each edit's cells were edited before, but its design
+//                is none of the last two, which every stage would answer from memory (undo)
 //   vector_drag  the eigenvector stage of a stroke dragged over fresh cells (one cell per edit)
 //   update_drag  the edit-to-picture update of those edits
 #include <cstdint>

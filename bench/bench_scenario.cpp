@@ -129,7 +129,7 @@ BenchScenario make_bench_scenario(const TissueModel& model, const ScenarioOption
   s.design = bench_design(surface, model);
   const auto [lo, hi] = model.bounding_box_mm();
   const double stroke_z_mm = lo.z() + (hi.z() - lo.z()) / 3.0;
-  s.edited_stroke = stroke_across_top(surface, model, stroke_z_mm + surface.cell_size_mm());
+  for (int i = 1; i <= 2; ++i) s.edited_strokes.push_back(stroke_across_top(surface, model, stroke_z_mm + i * surface.cell_size_mm()));
   for (int i = 1; i <= kDragEdits && stroke_z_mm - (i + 1) * surface.cell_size_mm() > lo.z(); ++i)
     s.dragged_strokes.push_back(stroke_across_top(surface, model, stroke_z_mm - i * surface.cell_size_mm()));
   s.designed_stress = options.designed_stress;

@@ -41,7 +41,10 @@ struct ScenarioOptions {
 
 struct BenchScenario {
   StressDesign design;
-  DesignStroke edited_stroke;              ///< replaces design.strokes[0] in the update edit
+  /// Stroke 0 at 1 and 2 cells towards hi.z: the update edits move stroke 0 among these and its
+  /// own position in turn, so that no edit repeats one of the last two designs (which the
+  /// design, the equilibration and the preview would answer from memory, as after an undo).
+  std::vector<DesignStroke> edited_strokes;
   std::vector<DesignStroke> dragged_strokes;  ///< stroke 0 at 1, 2, ... cells towards lo.z (at most kDragEdits)
   std::vector<Vec6> residual_stress_kPa;   ///< per cell of the uncut model
   CutRequests incisions;                   ///< the preview's round incisions

@@ -144,5 +144,19 @@ TEST(BenchScenario, PrescribedStressIsBiaxialAboutTheZAxis) {
   }
 }
 
+// The update edits move stroke 0 among three positions in turn: with two remembered results per
+// stage, an edit that repeated one of the last two designs would time a recall, not an update.
+TEST(BenchScenario, UpdateEditsCycleThroughThreeDistinctStrokePositions) {
+  TissueModel model = make_tissue_model("cylinder", make_builtin_shape("cylinder", {Vec3i{12, 12, 10}, std::nullopt}));
+  const BenchScenario scenario = make_bench_scenario(model, ScenarioOptions{});
+  ASSERT_EQ(scenario.edited_strokes.size(), 2U);
+  const std::vector<Vec3>& own = scenario.design.strokes.front().points_mm;
+  const std::vector<Vec3>& first = scenario.edited_strokes[0].points_mm;
+  const std::vector<Vec3>& second = scenario.edited_strokes[1].points_mm;
+  EXPECT_NE(first, own);
+  EXPECT_NE(second, own);
+  EXPECT_NE(first, second);
+}
+
 }  // namespace
 }  // namespace cleave::bench

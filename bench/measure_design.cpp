@@ -16,8 +16,10 @@ namespace {
 
 constexpr double kMsPerSecond = 1e3;
 
+/// Stroke 0 of update edit number `edit`: the two edited positions and the design's own in turn.
 DesignStroke stroke_of_edit(const BenchScenario& scenario, int edit) {
-  return edit % 2 == 0 ? scenario.edited_stroke : scenario.design.strokes.front();
+  const auto turn = static_cast<std::size_t>(edit % 3);
+  return turn < scenario.edited_strokes.size() ? scenario.edited_strokes[turn] : scenario.design.strokes.front();
 }
 
 DesignControlPoint middle_of(const DesignStroke& stroke) {
@@ -27,7 +29,7 @@ DesignControlPoint middle_of(const DesignStroke& stroke) {
 /// Control-point edit number `edit`: add, move, delete in turn (the added point is the last one).
 void control_point_edit(StressDesigner& designer, const BenchScenario& scenario, int edit) {
   switch (edit % 3) {
-    case 0: designer.add_control_point(middle_of(scenario.edited_stroke)); break;
+    case 0: designer.add_control_point(middle_of(scenario.edited_strokes.front())); break;
     case 1:
       designer.move_control_point(designer.design().control_points.size() - 1, middle_of(scenario.design.strokes.front()));
       break;
