@@ -106,6 +106,11 @@ TEST(StaticSolver, TheLastTwoStressesAreAnsweredWithoutASolve) {
   EXPECT_FALSE(third_a.remembered);
   EXPECT_EQ(statics.solves(), 4);
   EXPECT_LT(max_difference_mm(third_a.displacement_mm, first_a.displacement_mm), 1e-12 * max_norm_mm(first_a.displacement_mm));
+
+  StaticSolver one_shot(model, options);  // solve_static's use: nothing kept
+  (void)one_shot.solve_once(a);
+  EXPECT_FALSE(one_shot.solve(a).remembered);
+  EXPECT_EQ(one_shot.solves(), 2);
 }
 
 TEST(StaticSolver, NoLoadNeedsNoSolveAndMovesNothing) {

@@ -16,11 +16,11 @@ void require_converged(const SolveReport& report, std::string_view solver, const
 
 StaticResult solve_static(const TissueModel& model, const SparseMatrix& stiffness, std::span<const Vec6> residual_stress_kPa,
                           const StaticOptions& options) {
-  return StaticSolver(model, stiffness, options).solve(residual_stress_kPa);
+  return StaticSolver(model, stiffness, options).solve_once(residual_stress_kPa);
 }
 
 StaticResult solve_static(const TissueModel& model, std::span<const Vec6> residual_stress_kPa, const StaticOptions& options) {
-  return StaticSolver(model, options).solve(residual_stress_kPa);
+  return StaticSolver(model, options).solve_once(residual_stress_kPa);
 }
 
 }  // namespace cleave

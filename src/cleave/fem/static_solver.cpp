@@ -40,12 +40,12 @@ StaticResult StaticSolver::solve(std::span<const Vec6> residual_stress_kPa) {
     recalled.remembered = true;
     return recalled;
   }
-  StaticResult result = solve_anew(residual_stress_kPa);
+  StaticResult result = solve_once(residual_stress_kPa);
   recent_.remember(residual_stress_kPa, result);
   return result;
 }
 
-StaticResult StaticSolver::solve_anew(std::span<const Vec6> residual_stress_kPa) {
+StaticResult StaticSolver::solve_once(std::span<const Vec6> residual_stress_kPa) {
   const LinkedVolume& volume = model_.volume;
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   Vector f = Vector::Zero(dofs);

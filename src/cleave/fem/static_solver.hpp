@@ -31,6 +31,9 @@ class StaticSolver {
   /// last two solved is answered from memory (`remembered` set, no solve: undo, redo, a drag
   /// back in the studio). Throws as solve_static.
   StaticResult solve(std::span<const Vec6> residual_stress_kPa);
+  /// The same without remembering (nor looking up) the stress and its result: solve_static's
+  /// one-shot use, which would only copy both (~70 MB at a million cells).
+  StaticResult solve_once(std::span<const Vec6> residual_stress_kPa);
 
   /// Sets the linear solver up now (a CHOLMOD factorization, a multigrid hierarchy) instead of at
   /// the first loaded solve, e.g. on another thread while the caller shows something else; then
@@ -42,7 +45,6 @@ class StaticSolver {
 
  private:
   static constexpr std::size_t kRememberedLoads = 2;
-  StaticResult solve_anew(std::span<const Vec6> residual_stress_kPa);
 
   const TissueModel& model_;
   StaticOptions options_;
