@@ -291,7 +291,7 @@ test('a burst of edits supersedes stale work: progress shows, only the newest re
     // The page shows the time of every stage.
     const table = await page.locator('#timing-table').textContent();
     for (const stage of ['eigenvalues', 'equilibration', 'cut model', 'wound opening (frames)', 'one simulation frame',
-      'incisions open (statics)', 'surface and fields', 'edit to picture'])
+      'incisions open (statics)', 'surface and fields', 'computed (server)'])
       assert.match(table, new RegExp(`${stage.replace(/[()]/g, '\\$&')}\\d+ ms`), `timing of ${stage}`);
     console.log(`# studio timings on the abdomen ${RES}: cut result ${JSON.stringify(r.timings_ms)}; results for edits ${after.seqs.join(',')}`);
     // A stroke edit on the designed body: stroke to picture.

@@ -131,7 +131,14 @@ test('the round-incision preview opens the incisions once stroke and magnitude a
     assert.ok(r.fields.displacement_mm.some((d) => d > 0.01), 'the surface is displaced');
     assert.ok(r.timings_ms.total > 0 && Number.isFinite(r.timings_ms.total));
     assert.match(await page.locator('#timings').textContent(), /total \d+ ms/);
-    assert.match(await page.locator('#timing-table').textContent(), /edit to picture\d+ ms/);
+    assert.match(await page.locator('#timing-table').textContent(), /computed \(server\)\d+ ms/);
+    // The page's own clock: from sending its last edit to the frame that shows the result.
+    await page.waitForFunction(() => window.studio.app.pictureMs.length > 0);
+    const table = await page.locator('#timing-table').textContent();
+    assert.match(table, /received and decoded \(page\)\d+ ms/);
+    assert.match(table, /edit to picture \(page\)\d+ ms/);
+    const pictureMs = await page.evaluate(() => window.studio.app.pictureMs.at(-1));
+    assert.ok(pictureMs > r.timings_ms.total, `edit to picture ${pictureMs} ms includes the server's ${r.timings_ms.total} ms`);
     await page.click('button[data-tool=orbit]');
     // Eigenvalue map with its legend in kPa; the equilibrium residual; the incisions' cut faces.
     await page.selectOption('#display', 'langer');

@@ -11,6 +11,7 @@ export class Connection {
     this.nextReq = 1;
     this.pending = new Map();
     this.backoffMs = 250;
+    this.lastDecodeMs = 0;
     this.open();
   }
 
@@ -24,7 +25,9 @@ export class Connection {
     };
     ws.onmessage = (event) => {
       let message;
+      const start = performance.now();
       try { message = unpackMessage(JSON.parse(event.data)); } catch { return; }
+      this.lastDecodeMs = performance.now() - start;  // parse and unpack of the last message
       if (message.req !== undefined && this.pending.has(message.req)) {
         const { resolve, reject } = this.pending.get(message.req);
         this.pending.delete(message.req);

@@ -18,7 +18,10 @@ const app = {
   resultSeqs: [],       // the edit (seq) of every result received, in order
   progressCount: 0,     // progress messages seen (work longer than 0.25 s)
   lastProgress: null,
+  pictureMs: [],        // per edit sent from this page: send to the frame that shows its result (ms)
 };
+/// The edit whose picture this page waits for: sent at t0 (performance.now()), acknowledged as seq.
+const pictureClock = { t0: null, seq: null };
 window.studio = { app, viewer, pickAt: (x, y) => viewer.pick(x, y), screenOf: (p) => viewer.screenOf(p) };
 
 function setMessage(text, isError = false) {
@@ -58,6 +61,7 @@ function onMessage(m) {
     viewer.setResult(m);
     refreshDesign();
     showTimings(m.timings_ms || {});
+    notePicture(m);
     showNotes(m);
     $('progress').hidden = true;
     showPreview(m.incisions || []);
@@ -99,16 +103,44 @@ function onMessage(m) {
 }
 
 const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', equilibration: 'equilibration', cuts: 'cut model', opening: 'wound opening (frames)',
-  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', streamlines: 'streamlines', measurements: 'incision and wound measurements', total: 'edit to picture' };
+  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', streamlines: 'streamlines', measurements: 'incision and wound measurements', total: 'computed (server)' };
+/// Rows the page measures itself, after the server's stages.
+const PAGE_ROWS = { decode: 'received and decoded (page)', picture: 'edit to picture (page)' };
+const pageTimes = {};
+
+function timingRow(label, ms) {
+  const tr = document.createElement('tr');
+  tr.innerHTML = `<td>${label}</td><td>${ms.toFixed(0)} ms</td>`;
+  return tr;
+}
 function showTimings(t) {
-  const rows = Object.keys(STAGES).filter((k) => t[k] !== undefined).map((k) => {
-    const tr = document.createElement('tr');
-    tr.innerHTML = `<td>${STAGES[k]}</td><td>${t[k].toFixed(0)} ms</td>`;
-    return tr;
-  });
-  $('timing-table').replaceChildren(...rows);
-  $('timing-total').textContent = t.total !== undefined ? `${t.total.toFixed(0)} ms` : '–';
+  pageTimes.decode = connection.lastDecodeMs;
+  delete pageTimes.picture;  // until this result's picture is drawn (edits sent from this page)
+  renderTimings(t);
   $('timings').textContent = Object.entries(t).map(([k, v]) => `${k} ${v.toFixed(0)} ms`).join(' · ');
+}
+
+function renderTimings(t) {
+  const rows = Object.keys(STAGES).filter((k) => t[k] !== undefined).map((k) => timingRow(STAGES[k], t[k]));
+  for (const [k, label] of Object.entries(PAGE_ROWS)) if (pageTimes[k] !== undefined) rows.push(timingRow(label, pageTimes[k]));
+  $('timing-table').replaceChildren(...rows);
+  const headline = pageTimes.picture !== undefined ? pageTimes.picture : t.total;
+  $('timing-total').textContent = headline !== undefined ? `${headline.toFixed(0)} ms` : '–';
+}
+
+/// The time from sending an edit to the frame that shows its result, for the edits this page sent:
+/// taken in the animation frame after the result reached the viewer (network, the server's work,
+/// the transfer, decoding and the geometry upload included).
+function notePicture(m) {
+  if (pictureClock.seq === null || m.seq === undefined || m.seq < pictureClock.seq) return;
+  const t0 = pictureClock.t0;
+  pictureClock.seq = null;
+  requestAnimationFrame(() => {
+    const ms = performance.now() - t0;
+    app.pictureMs.push(ms);
+    pageTimes.picture = ms;
+    if (app.result === m) renderTimings(m.timings_ms || {});
+  });
 }
 
 /// The round-incision preview in numbers: how far the margins open and how elliptic they become.
@@ -139,7 +171,9 @@ window.studio.connection = connection;
 
 async function send(cmd, fields = {}) {
   try {
+    const t0 = performance.now();
     const reply = await connection.request(cmd, fields);
+    if (reply.type === 'ack') Object.assign(pictureClock, { t0, seq: reply.seq });
     setMessage(reply.type === 'ack' ? `${cmd}: done (edit ${reply.seq})` : `${cmd}: ${reply.type}`);
     return reply;
   } catch (e) {

@@ -37,10 +37,25 @@ export class Viewer {
     this.display = 'plain';
     this.result = null;
     this.size = 100;
+    // Rendering on demand: the scene is drawn in the animation frame after something changed (the
+    // camera, a result, a simulation frame, the design, the display, the size), not in every
+    // frame. A continuous loop kept a core busy: in software rendering (headless Chromium) it
+    // took seconds per frame and doubled the server's edit times on this 2-core machine.
+    this.renderPending = false;
+    for (const name of ['resize', 'setResult', 'showFrame', 'resetView', 'setDisplay', 'setDesign']) {
+      const method = this[name].bind(this);
+      this[name] = (...args) => { const r = method(...args); this.requestRender(); return r; };
+    }
+    this.controls.addEventListener('change', () => this.requestRender());
     new ResizeObserver(() => this.resize()).observe(canvas.parentElement);
     this.resize();
-    const loop = () => { this.render(); requestAnimationFrame(loop); };
-    requestAnimationFrame(loop);
+  }
+
+  /// Draws the scene in the next animation frame (once, however often it is asked for before).
+  requestRender() {
+    if (this.renderPending) return;
+    this.renderPending = true;
+    requestAnimationFrame(() => { this.renderPending = false; this.render(); });
   }
 
   resize() {
