@@ -292,6 +292,17 @@ bool run_narrow(Eigen::MatrixXd& y, const Fn& fn) {
   }
 }
 
+/// The forward steps of `supernodes` in their order (ascending: children before parents) on y.
+template <typename Kernels>
+void forward_in_order(const std::vector<Supernode>& supernodes, typename Kernels::Matrix& y) {
+  for (const Supernode& sn : supernodes) {
+    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
+      Kernels::forward_large(sn, y);
+    else
+      Kernels::forward(sn, y, [&](int row, const auto& update) { y.row(row) -= update; });
+  }
+}
+
 }  // namespace
 
 SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
@@ -510,12 +521,8 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
   Eigen::MatrixXd w = Eigen::MatrixXd::Zero(static_cast<Eigen::Index>(reached_rows.size()), b_rows.cols());
   for (std::size_t i = 0; i < rows.size(); ++i)
     w.row(slot[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(rows[i])])]) += b_rows.row(static_cast<Eigen::Index>(i));
-  for (const Supernode& sn : compact) {
-    if (sn.rows * sn.columns >= kParallelSupernodeEntries)
-      forward_large_supernode(sn, w);
-    else
-      forward_supernode(sn, w, [&](int row, const auto& update) { w.row(row) -= update; });
-  }
+  if (!run_narrow(w, [&](auto kernels, RhsRows& by_rows) { forward_in_order<decltype(kernels)>(compact, by_rows); }))
+    forward_in_order<WideKernels>(compact, w);
   return w;
 }
 
@@ -543,7 +550,10 @@ Eigen::MatrixXd SupernodalSubstitution::backward_rows(const cholmod_factor& fact
   const std::vector<int> visit = supernodes_above(rows);
   const double* values = values_of(factor);
   // From the root down: each supernode reads the rows below its columns, its ancestors', done before it.
-  for (auto it = visit.rbegin(); it != visit.rend(); ++it) backward_any_supernode(supernode_of(factor, values, *it), y);
+  const auto back_from_root = [&](auto kernels, auto& rhs) {
+    for (auto it = visit.rbegin(); it != visit.rend(); ++it) decltype(kernels)::backward_any(supernode_of(factor, values, *it), rhs);
+  };
+  if (!run_narrow(y, [&](auto kernels, RhsRows& by_rows) { back_from_root(kernels, by_rows); })) back_from_root(WideKernels{}, y);
   Eigen::MatrixXd x(static_cast<Eigen::Index>(rows.size()), y.cols());
   for (std::size_t i = 0; i < rows.size(); ++i)
     x.row(static_cast<Eigen::Index>(i)) = y.row(inverse_permutation_[static_cast<std::size_t>(rows[i])]);
