@@ -60,12 +60,18 @@ TEST(StaticSolver, RepeatedSolvesEqualFreshSolvesOnACutBodyWithPrescribedSupport
   EXPECT_EQ(statics.solves(), 3);
 }
 
-TEST(StaticSolver, SetUpOnAnotherThreadThenSolvedHereEqualsAFreshSolve) {
-  // The studio factors a new cut model on a thread of its own and solves with it on its worker.
-  const TissueModel model = test::make_box_model({6, 3, 3}, 2.0);
+/// CHOLMOD statics of a 6 x 3 x 3 box of 2 mm cells held at x = 0.
+StaticOptions held_at_left_end(const TissueModel& model) {
   StaticOptions options;
   options.solver = SolverKind::cholmod;
   options.fixed_vertices = vertices_in_box(model.volume, Vec3(-0.1, -1, -1), Vec3(0.1, 7, 7));
+  return options;
+}
+
+TEST(StaticSolver, SetUpOnAnotherThreadThenSolvedHereEqualsAFreshSolve) {
+  // The studio factors a new cut model on a thread of its own and solves with it on its worker.
+  const TissueModel model = test::make_box_model({6, 3, 3}, 2.0);
+  const StaticOptions options = held_at_left_end(model);
   StaticSolver statics(model, options);
   std::thread([&] { statics.set_up_solver(); }).join();
   EXPECT_TRUE(statics.set_up());
@@ -84,9 +90,7 @@ TEST(StaticSolver, SetUpOnAnotherThreadThenSolvedHereEqualsAFreshSolve) {
 // pushes the oldest out.
 TEST(StaticSolver, TheLastTwoStressesAreAnsweredWithoutASolve) {
   const TissueModel model = test::make_box_model({6, 3, 3}, 2.0);
-  StaticOptions options;
-  options.solver = SolverKind::cholmod;
-  options.fixed_vertices = vertices_in_box(model.volume, Vec3(-0.1, -1, -1), Vec3(0.1, 7, 7));
+  const StaticOptions options = held_at_left_end(model);
   StaticSolver statics(model, options);
   const std::vector<Vec6> a = graded_stress(model.volume, 10.0);
   const std::vector<Vec6> b = graded_stress(model.volume, -4.0);

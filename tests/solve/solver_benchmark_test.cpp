@@ -34,13 +34,18 @@ struct Systems {
   test::LinearSystem statics, dynamics;
 };
 
-Systems tube_44k() {
+/// A built-in shape at `cells` of the test tissue (one material).
+TissueModel tissue_model(const std::string& shape, const Vec3i& cells) {
   ShapeResolution resolution;
-  resolution.cells = Vec3i(42, 42, 51);
+  resolution.cells = cells;
   Material m;
   m.youngs_modulus_kPa = test::kTissueE_kPa;
   m.poisson_ratio = test::kTissueNu;
-  Systems s{make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}}), {}, {}};
+  return make_tissue_model(shape, make_builtin_shape(shape, resolution), {{Label{1}, m}});
+}
+
+Systems tube_44k() {
+  Systems s{tissue_model("cylinder", Vec3i(42, 42, 51)), {}, {}};
   const LinkedVolume& volume = s.model.volume;
   const SparseMatrix k = assemble_stiffness(s.model);
   const Vector mass = lumped_mass(s.model);
@@ -61,15 +66,6 @@ Systems tube_44k() {
   s.statics.a.makeCompressed();
   s.dynamics.a.makeCompressed();
   return s;
-}
-
-TissueModel abdomen_126() {
-  ShapeResolution resolution;
-  resolution.cells = Vec3i(126, 41, 84);
-  Material m;
-  m.youngs_modulus_kPa = test::kTissueE_kPa;
-  m.poisson_ratio = test::kTissueNu;
-  return make_tissue_model("abdomen", make_builtin_shape("abdomen", resolution), {{Label{1}, m}});
 }
 
 /// The statics of `model` held at its lowest x, a uniform load along x.
@@ -183,7 +179,7 @@ TEST(SolverBenchmark, DISABLED_Tube44kSubstitution) {
   keep_freed_memory_for_reuse();  // as the CLI does: no page faults for the repeated arrays
   Systems s = tube_44k();
   if (const char* shape = std::getenv("CLEAVE_BENCH_SHAPE"); shape != nullptr && std::string(shape) == "abdomen") {
-    s.model = abdomen_126();
+    s.model = tissue_model("abdomen", Vec3i(126, 41, 84));
     s.statics = held_at_lowest_x(s.model);
   }
   test::CholmodFactor factor(s.statics.a);
