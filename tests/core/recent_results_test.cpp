@@ -11,7 +11,7 @@ namespace cleave {
 namespace {
 
 TEST(RecentResults, FindsOnlyEqualInputsAndForgetsTheOldestPastItsCapacity) {
-  RecentResults<double, std::string> recent(2);
+  RecentResults<std::vector<double>, std::string> recent(2);
   const std::vector<double> a{1.0, 2.0}, b{3.0}, c{1.0, 2.0, 3.0};
   const auto found = [&](const std::vector<double>& input) {
     const std::string* result = recent.find(input);

@@ -4,36 +4,39 @@
 // back to an earlier design (undo, redo, a stroke dragged back) gives a field equal to one
 // computed before, bit for bit, and is answered without solving again.
 //
-//   RecentResults<Vec6, StaticResult> recent(2);
-//   if (const StaticResult* known = recent.find(stress_kPa)) return *known;
-//   ...; recent.remember(stress_kPa, result);
+//   RecentResults<std::vector<Vec6>, StaticResult> recent(2);
+//   if (const StaticResult* known = recent.find(stress_kPa)) return *known;   // a span probes
+//   ...; recent.remember({stress_kPa.begin(), stress_kPa.end()}, result);
 //
-// Inputs are compared exactly (element by element with ==): a field that differs in one bit is
-// a new input. The newest result is found first; past `capacity` the oldest is forgotten.
+// Inputs are compared exactly: ranges element by element with ==, other keys with their own ==
+// (which may take a probe of another type, e.g. references to the caller's arrays, so that a
+// lookup copies nothing). The newest result is found first; past `capacity` the oldest is
+// forgotten.
 #include <algorithm>
 #include <cstddef>
 #include <deque>
-#include <span>
-#include <vector>
+#include <ranges>
+#include <utility>
 
 namespace cleave {
 
-template <typename Element, typename Result>
+template <typename Key, typename Result>
 class RecentResults {
  public:
   explicit RecentResults(std::size_t capacity) : capacity_(capacity) {}
 
-  /// The result remembered for an input equal to `input`, or nullptr.
-  const Result* find(std::span<const Element> input) const {
+  /// The result remembered for a key equal to `probe`, or nullptr.
+  template <typename Probe>
+  const Result* find(const Probe& probe) const {
     for (const Entry& e : entries_)
-      if (std::ranges::equal(e.input, input)) return &e.result;
+      if (same(e.key, probe)) return &e.result;
     return nullptr;
   }
 
-  /// Remembers `result` for `input` as the newest entry (an equal input's older entry is replaced).
-  void remember(std::span<const Element> input, Result result) {
-    std::erase_if(entries_, [&](const Entry& e) { return std::ranges::equal(e.input, input); });
-    entries_.push_front(Entry{std::vector<Element>(input.begin(), input.end()), std::move(result)});
+  /// Remembers `result` for `key` as the newest entry (an equal key's older entry is replaced).
+  void remember(Key key, Result result) {
+    std::erase_if(entries_, [&](const Entry& e) { return same(e.key, key); });
+    entries_.push_front(Entry{std::move(key), std::move(result)});
     while (entries_.size() > capacity_) entries_.pop_back();
   }
 
@@ -42,9 +45,16 @@ class RecentResults {
 
  private:
   struct Entry {
-    std::vector<Element> input;
+    Key key;
     Result result;
   };
+  template <typename Probe>
+  static bool same(const Key& key, const Probe& probe) {
+    if constexpr (std::ranges::range<Key> && std::ranges::range<Probe>)
+      return std::ranges::equal(key, probe);
+    else
+      return key == probe;
+  }
   std::size_t capacity_;
   std::deque<Entry> entries_;
 };

@@ -41,7 +41,7 @@ StaticResult StaticSolver::solve(std::span<const Vec6> residual_stress_kPa) {
     return recalled;
   }
   StaticResult result = solve_once(residual_stress_kPa);
-  recent_.remember(residual_stress_kPa, result);
+  recent_.remember({residual_stress_kPa.begin(), residual_stress_kPa.end()}, result);
   return result;
 }
 

@@ -11,6 +11,7 @@
 // The model must outlive the solver and keep its topology (no cut) while the solver is used.
 #include <memory>
 #include <span>
+#include <vector>
 
 #include "cleave/core/recent_results.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
@@ -55,7 +56,7 @@ class StaticSolver {
   std::unique_ptr<LinearSolver> solver_;
   bool set_up_ = false;
   int solves_ = 0;
-  RecentResults<Vec6, StaticResult> recent_{kRememberedLoads};
+  RecentResults<std::vector<Vec6>, StaticResult> recent_{kRememberedLoads};
 };
 
 }  // namespace cleave

@@ -62,7 +62,7 @@ struct StressEquilibrator::Impl {
     EquilibrationResult result;
     Vector u;
   };
-  RecentResults<Vec6, Known> recent{kRememberedDesigns};
+  RecentResults<std::vector<Vec6>, Known> recent{kRememberedDesigns};
   std::vector<std::uint8_t> held_dof;  ///< per dof: 1 = vertex held (Gamma_D)
 
   Impl(const TissueModel& m, std::span<const VertexId> held_vertices)
@@ -295,7 +295,7 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
                                    "preconditioned CG iterations (required {:.0e})",
                                    result.force_reduction, result.refinement_steps, kRequiredReduction));
   }
-  impl_->recent.remember(designed_kPa, Impl::Known{result, impl_->u});
+  impl_->recent.remember({designed_kPa.begin(), designed_kPa.end()}, Impl::Known{result, impl_->u});
   return result;
 }
 

@@ -15,6 +15,7 @@
 #include <vector>
 
 #include "cleave/core/error.hpp"
+#include "cleave/core/recent_results.hpp"
 #include "cleave/solve/forward_column_batches.hpp"
 #include "cleave/solve/supernodal_substitution.hpp"
 
@@ -149,6 +150,22 @@ constexpr double kSparseAdvantage = 2.0;
 /// Solutions kept for systems that come back (an undo and a redo, a drag back and forth).
 constexpr std::size_t kRememberedSolutions = 2;
 
+/// A system solved with the factor, as RecentResults keys it: its diagonal (the off-diagonal
+/// entries are the factorized ones) and right-hand side. A SystemProbe compares the caller's
+/// arrays with it without copying them.
+struct SystemProbe {
+  const Eigen::VectorXd& diagonal;
+  const Eigen::MatrixXd& b;
+};
+struct SolvedSystem {
+  Eigen::VectorXd diagonal;
+  Eigen::MatrixXd b;
+  bool operator==(const SystemProbe& p) const {
+    return b.rows() == p.b.rows() && b.cols() == p.b.cols() && diagonal.size() == p.diagonal.size() && diagonal == p.diagonal && b == p.b;
+  }
+  bool operator==(const SolvedSystem& other) const { return *this == SystemProbe{other.diagonal, other.b}; }
+};
+
 /// Right-hand sides up to this many columns are substituted on all cores (SupernodalSubstitution);
 /// wider blocks go to CHOLMOD's solve, whose BLAS-3 kernels already use them.
 constexpr Eigen::Index kParallelSubstitutionColumns = 8;
@@ -179,23 +196,10 @@ struct SparseCholesky::Impl {
   double sparse_apply_seconds = 0;  ///< per right-hand side column: the first application of the update
   // The last kRememberedSolutions systems solved with this factor (their diagonal and b: the
   // off-diagonal entries are the factorized ones) and their solutions, newest first.
-  struct Remembered {
-    Eigen::VectorXd diagonal;
-    Eigen::MatrixXd b;
-    Eigen::MatrixXd x;
-  };
-  std::vector<Remembered> remembered;
+  RecentResults<SolvedSystem, Eigen::MatrixXd> remembered{kRememberedSolutions};
 
-  /// The remembered solution of the system with this diagonal (off-diagonal entries the factorized
-  /// ones) and right-hand side, or null.
-  const Eigen::MatrixXd* remembered_solution(const Eigen::VectorXd& a_diagonal, const Eigen::MatrixXd& b) const {
-    for (const Remembered& r : remembered)
-      if (r.b.rows() == b.rows() && r.b.cols() == b.cols() && r.diagonal == a_diagonal && r.b == b) return &r.x;
-    return nullptr;
-  }
   void remember(Eigen::VectorXd a_diagonal, const Eigen::MatrixXd& b, const Eigen::MatrixXd& x) {
-    remembered.insert(remembered.begin(), Remembered{std::move(a_diagonal), b, x});
-    if (remembered.size() > kRememberedSolutions) remembered.pop_back();
+    remembered.remember(SolvedSystem{std::move(a_diagonal), b}, x);
   }
 
   bool same_pattern(const Eigen::SparseMatrix<double>& a) const {
@@ -523,7 +527,7 @@ bool SparseCholesky::solve_diagonal_update(const Eigen::SparseMatrix<double>& a,
 }
 
 bool SparseCholesky::recall(const Eigen::VectorXd& a_diagonal, const Eigen::MatrixXd& b, Eigen::MatrixXd& x) const {
-  const Eigen::MatrixXd* known = impl_->remembered_solution(a_diagonal, b);
+  const Eigen::MatrixXd* known = impl_->remembered.find(SystemProbe{a_diagonal, b});
   if (known == nullptr) return false;
   x = *known;
   ++remembered_solves_;
