@@ -456,8 +456,15 @@ void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eige
   Eigen::MatrixXd y(n, b.cols());
   for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(permuted(k));
 
-  forward(factor, y);
-  backward(factor, y);
+  // Both sweeps on one copy by rows (2 to 8 columns), not a copy each.
+  const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) {
+    forward_with<decltype(kernels)>(factor, rows);
+    backward_with<decltype(kernels)>(factor, rows);
+  });
+  if (!narrow) {
+    forward_with<WideKernels>(factor, y);
+    backward_with<WideKernels>(factor, y);
+  }
   for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
 }
 
