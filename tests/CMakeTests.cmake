@@ -26,3 +26,11 @@ if(CLEAVE_NODE AND TARGET cleave_cli)
     TIMEOUT 600
     ENVIRONMENT "CLEAVE_BIN=$<TARGET_FILE:cleave_cli>;CLEAVE_STUDIO_PORT=0;CLEAVE_SCREENSHOTS=${PROJECT_BINARY_DIR}/browser-screenshots")
 endif()
+
+# The page's message reader (web/js/packed.js) alone: node only, no server or browser.
+if(CLEAVE_NODE)
+  add_test(NAME web_message_reader
+           COMMAND ${CLEAVE_NODE} --test ${CMAKE_CURRENT_SOURCE_DIR}/browser/packed.test.mjs
+           WORKING_DIRECTORY ${PROJECT_SOURCE_DIR})
+  set_tests_properties(web_message_reader PROPERTIES LABELS "web")
+endif()

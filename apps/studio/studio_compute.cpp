@@ -24,6 +24,7 @@
 #include "studio/cut_face_values.hpp"
 #include "studio/finite_message.hpp"
 #include "studio/packed_array.hpp"
+#include "studio/wire_message.hpp"
 
 namespace cleave::studio {
 namespace {
@@ -99,7 +100,7 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
         // How much work the edits caused: a burst of edits starts fewer computations than edits
         // (the worker drops stale ones), which the page and its tests can see.
         if (r.message.value("type", "") != "result") {
-          send_(r.message.dump());
+          send_(wire_encoded(r.message));
           return;
         }
         r.message["computations"] = {{"started", worker_->jobs_started()}, {"published", ++results_published_}};
@@ -115,7 +116,7 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
           }
           broadcast_surface_id_ = id;
         }
-        std::string text = r.message.dump();
+        std::string text = wire_encoded(r.message);
         if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
         {
           std::lock_guard lock(latest_mutex_);
@@ -135,7 +136,7 @@ void StudioCompute::design_changed(const DesignState& design, std::uint64_t seq)
 std::vector<std::string> StudioCompute::welcome_messages() const {
   std::lock_guard lock(latest_mutex_);
   if (latest_result_.is_null()) return {};
-  return {latest_result_.dump()};
+  return {wire_encoded(latest_result_)};
 }
 
 void StudioCompute::prepare(const FieldWorker::Context& ctx) {
@@ -283,7 +284,7 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     if (i > 0) step_ms += ms_since(ts);
     frame["step_ms"] = i > 0 ? step_ms / i : 0.0;
     frame = checked_outgoing(std::move(frame));
-    send_(frame.dump());
+    send_(wire_encoded(frame));
     if (frame["type"] == "error") return;  // the statics after it report the result (or its error)
   }
   timings["opening"] = ms_since(t0);

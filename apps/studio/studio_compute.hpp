@@ -28,7 +28,8 @@ namespace cleave::studio {
 
 class StudioCompute {
  public:
-  /// `send` delivers a message to every client (thread safe; called from the worker thread).
+  /// `send` delivers a message to every client (thread safe; called from the worker thread):
+  /// JSON text, or the binary form of wire_message.hpp for results and frames.
   StudioCompute(const StudioSession& session, std::function<void(std::string)> send);
   ~StudioCompute();
 

@@ -11,6 +11,7 @@ import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
+import { decodeMessage } from '../../web/js/packed.js';
 import { freshSessionDir, requireTools, startServer } from './harness.mjs';
 
 const SOAK_SECONDS = Number(process.env.CLEAVE_SOAK_SECONDS || 20);  // bounded soak; 60 s in docs/ROBUSTNESS.md
@@ -39,10 +40,11 @@ function rawGet(port, rawPath) {
 function openSocket(url) {
   return new Promise((resolve, reject) => {
     const ws = new WebSocket(url.replace('http', 'ws') + 'ws');
+    ws.binaryType = 'arraybuffer';  // results and frames are binary messages (web/js/packed.js)
     const replies = new Map();
     ws.pending = replies;
     ws.onmessage = (e) => {
-      const m = JSON.parse(e.data);
+      const m = decodeMessage(e.data);
       if (m.req !== undefined && replies.has(m.req)) { replies.get(m.req).resolve(m); replies.delete(m.req); }
       if (ws.onpush) ws.onpush(m);
     };

@@ -20,6 +20,7 @@
 #include "studio/studio_compute.hpp"
 #include "studio/studio_main.hpp"
 #include "studio/studio_session.hpp"
+#include "studio/wire_message.hpp"
 
 namespace cleave::studio {
 namespace {
@@ -75,7 +76,7 @@ TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
   std::vector<json> sent;
   StudioCompute compute(session, [&](std::string text) {
     std::lock_guard lock(m);
-    sent.push_back(json::parse(text));
+    sent.push_back(wire_decoded(text));
   });
   compute.design_changed(session.design(), session.seq());
   compute.wait_idle();
@@ -130,7 +131,7 @@ struct ResultLog {
   std::vector<json> results;
   std::function<void(std::string)> sender() {
     return [this](std::string text) {
-      json message = json::parse(text);
+      json message = wire_decoded(text);
       std::lock_guard lock(mutex);
       if (message["type"] == "result") results.push_back(std::move(message));
     };
@@ -186,7 +187,8 @@ TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGet
   // A client that connects now gets the latest result (the undo's) with its triangles.
   const std::vector<std::string> welcome = compute.welcome_messages();
   ASSERT_EQ(welcome.size(), 1u);
-  const json latest = json::parse(welcome[0]);
+  EXPECT_TRUE(is_binary_wire(welcome[0])) << "a result with packed arrays travels as a binary message";
+  const json latest = wire_decoded(welcome[0]);
   EXPECT_EQ(latest["seq"], results[3]["seq"]);
   ASSERT_TRUE(results[3]["surface"].contains("triangles")) << "undoing the cut returns to a surface the clients do not hold";
   EXPECT_NE(results[3]["surface"]["id"], first["id"]) << "rebuilt, so named anew";

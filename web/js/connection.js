@@ -1,7 +1,7 @@
 // The WebSocket to the studio server: request/reply matching by "req", pushes dispatched by
-// "type", and automatic reconnection (a client that reconnects says hello and resumes). Packed
-// arrays (packed.js) arrive as typed arrays.
-import { unpackMessage } from './packed.js';
+// "type", and automatic reconnection (a client that reconnects says hello and resumes). Results
+// and frames arrive as binary messages whose packed arrays become typed arrays (packed.js).
+import { decodeMessage } from './packed.js';
 
 export class Connection {
   constructor(url, onMessage, onStatus) {
@@ -17,6 +17,7 @@ export class Connection {
 
   open() {
     const ws = new WebSocket(this.url);
+    ws.binaryType = 'arraybuffer';
     this.ws = ws;
     ws.onopen = () => {
       this.backoffMs = 250;
@@ -26,7 +27,12 @@ export class Connection {
     ws.onmessage = (event) => {
       let message;
       const start = performance.now();
-      try { message = unpackMessage(JSON.parse(event.data)); } catch { return; }
+      try {
+        message = decodeMessage(event.data);
+      } catch (e) {
+        console.error(`studio: a message from the server could not be read: ${e.message}`);
+        return;
+      }
       this.lastDecodeMs = performance.now() - start;  // parse and unpack of the last message
       if (message.req !== undefined && this.pending.has(message.req)) {
         const { resolve, reject } = this.pending.get(message.req);
