@@ -1,6 +1,7 @@
 // Incremental edits give the same field as a fresh design; failing edits change nothing.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <fmt/format.h>
 #include <limits>
 
@@ -63,6 +64,44 @@ TEST(Designer, AFailingEditLeavesTheDesignAsItWas) {
   EXPECT_EQ(designer.design().strokes.size(), 1u);
   EXPECT_EQ(designer.design().control_points.size(), 1u);
   EXPECT_EQ(designer.result().stress_kPa, before);
+}
+
+TEST(Designer, AnEditBackToOneOfTheLastTwoDesignsIsAnsweredFromMemory) {
+  const TissueModel m = test::builtin_model("plate", {Vec3i(16, 16, 2), std::nullopt});
+  StressDesign a;  // equilibrated (the default): every stage has work to skip
+  a.strokes = {DesignStroke{{{10, 50, 10}, {90, 50, 10}}, StrokePlacement::surface}};
+  a.control_points = {{{20, 20, 10}, 20, 10}};
+  const DesignStroke moved{{{10, 30, 10}, {90, 70, 10}}, StrokePlacement::surface};
+  StressDesigner designer(m, a);
+  const DesignResult first = designer.result();
+  EXPECT_FALSE(first.remembered);
+
+  designer.move_stroke(0, moved);  // B
+  const DesignResult b = designer.result();
+  EXPECT_FALSE(b.remembered);
+  designer.move_stroke(0, a.strokes[0]);  // back to A
+  EXPECT_TRUE(designer.result().remembered);
+  EXPECT_EQ(designer.result().stress_kPa, first.stress_kPa) << "the result computed for A, bit for bit";
+  EXPECT_EQ(designer.result().timings.directions_s, 0.0);
+  EXPECT_EQ(designer.result().timings.equilibration_s, 0.0);
+
+  designer.move_control_point(0, {{20, 20, 10}, 25, 10});  // C: A and C are the last two now
+  EXPECT_FALSE(designer.result().remembered);
+  designer.move_control_point(0, a.control_points[0]);  // A again: recalled because it was just used
+  EXPECT_TRUE(designer.result().remembered);
+  EXPECT_EQ(designer.result().stress_kPa, first.stress_kPa);
+
+  designer.move_stroke(0, moved);  // B was pushed out by C: computed again, and right
+  EXPECT_FALSE(designer.result().remembered);
+  StressDesign b_design = a;
+  b_design.strokes = {moved};
+  EXPECT_LT(relative_difference(designer.result(), design_residual_stress(m, b_design)), 1e-8);
+  EXPECT_LT(relative_difference(designer.result(), b), 1e-8);
+
+  DesignStroke one_ulp_off = a.strokes[0];  // not A: compared exactly
+  one_ulp_off.points_mm[0].x() = std::nextafter(one_ulp_off.points_mm[0].x(), 100.0);
+  designer.move_stroke(0, one_ulp_off);
+  EXPECT_FALSE(designer.result().remembered);
 }
 
 }  // namespace

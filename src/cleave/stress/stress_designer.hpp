@@ -19,12 +19,17 @@
 //   designer.move_control_point(0, {q, 25, 12});
 //   const DesignResult& r = designer.result();      // frames, eigenvalues, stress per cell
 //
+// The last two designs are remembered with their results: an edit back to one of them (compared
+// exactly: strokes, control points, solver, equilibration) is answered without redoing a stage
+// (DesignResult::remembered).
+//
 // The model must outlive the designer and keep its topology (build a new designer after a cut).
 // Edits that fail validation throw InputError and leave the designer unchanged. Indices out of
 // range are InputErrors too.
 #include <memory>
 #include <vector>
 
+#include "cleave/core/recent_results.hpp"
 #include "cleave/model/tissue_model.hpp"
 #include "cleave/stress/direction_frames.hpp"
 #include "cleave/stress/stress_design.hpp"
@@ -48,6 +53,9 @@ struct DesignResult {
   int eigenvalue_iterations = 0;         ///< CG iterations of the last eigenvalue solve (paper CG; for the default, CG
                                          ///< with the kept factor, 0 = direct solve or not redone)
   int equilibration_iterations = 0;      ///< CG iterations of the last equilibration (0 = none or already balanced)
+  /// The design equals one of the last two (undo, redo, a stroke dragged back): this is the
+  /// result computed for it then, and no stage was redone (timings 0).
+  bool remembered = false;
   DesignTimings timings;
 };
 
@@ -72,6 +80,16 @@ class StressDesigner {
 
  private:
   struct Operators;
+  /// What a result depends on besides the designer's fixed settings (weights, snap tolerance,
+  /// held vertices: set_design refuses changes of those).
+  struct DesignKey {
+    std::vector<DesignStroke> strokes;
+    std::vector<DesignControlPoint> control_points;
+    EigenvalueSolver solver = EigenvalueSolver::cholesky;
+    Equilibration equilibration = Equilibration::growth;
+    bool operator==(const DesignKey& other) const;
+  };
+  static DesignKey key_of(const StressDesign& design);
   void update_directions(const StressDesign& design, DesignResult& out);
   void update_eigenvalues(const StressDesign& design, DesignResult& out);
   void finish(const StressDesign& design, DesignResult& out);
@@ -80,6 +98,7 @@ class StressDesigner {
   StressDesign design_;
   std::unique_ptr<Operators> ops_;
   DesignResult result_;
+  RecentResults<DesignKey, DesignResult> recent_{2};
 };
 
 /// One-shot design (a StressDesigner without the edits).
