@@ -238,7 +238,15 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   apply_cut_plan(preview_model_->volume, plan_);
   preview_surface_ = std::make_unique<RenderSurface>(build_render_surface(*preview_model_));
   // Measurements sample the margins on the cut body's own surface (its split vertices).
-  cut_body_surface_ = plan_.incisions.empty() ? nullptr : std::make_unique<BodySurface>(*preview_model_);
+  // Their sample points do not depend on the displacement: sampled once per cut body.
+  incision_margins_.clear();
+  if (!plan_.incisions.empty()) {
+    const BodySurface cut_body_surface(*preview_model_);
+    incision_margins_.resize(plan_.incisions.size());
+    tbb::parallel_for(std::size_t{0}, plan_.incisions.size(), [&](std::size_t i) {
+      incision_margins_[i] = sample_incision_margins(cut_body_surface, plan_.incisions[i]);
+    });
+  }
   // The case's supports on the cut body, and the removed plugs (hidden, touching nothing: free,
   // corotated plugs had made the multigrid need 55-77 iterations per step at 45k cells).
   held_cut_ = held_vertices(*preview_model_, simulation_, plan_.hidden_cells());
@@ -455,7 +463,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
       CellId c = model.volume.cell_containing(frame.centre_mm - 0.5 * h * frame.normal);
       if (c == kNone) c = model.volume.cell_containing(frame.centre_mm - h * frame.normal);
       if (c != kNone && fields) reference = TangentDirection{fields->frames[static_cast<std::size_t>(c)].langer, 1.0};
-      const auto m = measure_incision(*cut_body_surface_, displacement_mm_, frame, reference);
+      const auto m = measure_incision(preview_model_->volume, incision_margins_[i], displacement_mm_, frame, reference);
       if (!m) return;
       nlohmann::json j = {{"centre_mm", {frame.centre_mm.x(), frame.centre_mm.y(), frame.centre_mm.z()}},
                           {"opening_mm", m->opening_mm},

@@ -19,6 +19,7 @@
 #include "cleave/stress/stress_designer.hpp"
 #include "cleave/surface/render_surface.hpp"
 #include "cleave/surface/surface_mesh.hpp"
+#include "cleave/viz/incision_ellipses.hpp"
 #include "studio/cut_face_values.hpp"
 #include "studio/field_worker.hpp"
 #include "studio/message_handler.hpp"
@@ -86,7 +87,7 @@ class StudioCompute {
   std::vector<Vec3> displacement_mm_;                 ///< of the last preview (per vertex of preview_model_)
   std::shared_ptr<TissueModel> preview_model_;        ///< the model cut by the preview and the user's cuts
   std::unique_ptr<RenderSurface> preview_surface_;
-  std::unique_ptr<BodySurface> cut_body_surface_;     ///< of preview_model_, for the measurements
+  std::vector<IncisionMargins> incision_margins_;    ///< per plan_.incisions: sampled on preview_model_'s surface
   CutFaceLayout cut_face_layout_;                     ///< cut faces of preview_model_ on preview_surface_, with their depth
   /// Statics of preview_model_ (stiffness, supports and CHOLMOD factor kept while the cuts do not
   /// change, so a design edit re-solves without refactoring); reset before preview_model_ changes.

@@ -196,6 +196,49 @@ TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGet
   EXPECT_EQ(unpacked_indices(latest["surface"]["triangles"]), triangles) << "the uncut surface again";
 }
 
+// The incision margins are sampled once per cut body (studio_compute.cpp) and reused for every
+// edit's displacement: after a cut they must be those of the new body, so a session that cut late
+// measures what a session that had the cut from the start measures.
+TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) {
+  const json demo = [] {
+    StudioSession probe(fresh_folder("measure-probe"), bare_model_case(kCoarseAbdomen));
+    return abdomen_demo_case(probe.model(), DemoStress::designed);
+  }();
+  const json& design = demo["design"];
+  // A scalpel cut along the first stroke: across the whole width, past several incisions' rims.
+  const json add_cut = {{"cmd", "add_cut"}, {"kind", "scalpel"}, {"path_mm", design["strokes"][0]["points"]}, {"depth_mm", 5.0}};
+  const auto last_result = [&](const std::string& name, bool cut_first) {
+    StudioSession session(fresh_folder(name), bare_model_case(kCoarseAbdomen));
+    ResultLog log;
+    StudioCompute compute(session, log.sender());
+    const auto edit = [&](const json& e, bool recompute) {
+      session.apply_edit(e);
+      if (!recompute) return;
+      compute.design_changed(session.design(), session.seq());
+      compute.wait_idle();
+    };
+    if (cut_first) edit(add_cut, false);
+    edit({{"cmd", "add_stroke"}, {"points_mm", design["strokes"][0]["points"]}}, !cut_first);
+    const json& p = design["control_points"][0];
+    edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", 20}, {"cross_kPa", 10}}, !cut_first);
+    if (!cut_first) edit(add_cut, false);
+    compute.design_changed(session.design(), session.seq());
+    compute.wait_idle();
+    std::lock_guard lock(log.mutex);
+    return log.results.back();
+  };
+  const json late = last_result("measure-late", false);
+  const json early = last_result("measure-early", true);
+  ASSERT_FALSE(early["incisions"].empty());
+  ASSERT_EQ(late["incisions"].size(), early["incisions"].size()) << "the cut removes the incisions it crosses";
+  for (std::size_t i = 0; i < early["incisions"].size(); ++i) {
+    EXPECT_NEAR(late["incisions"][i]["opening_mm"].get<double>(), early["incisions"][i]["opening_mm"].get<double>(), 1e-6) << i;
+    EXPECT_NEAR(late["incisions"][i]["axis_ratio"].get<double>(), early["incisions"][i]["axis_ratio"].get<double>(), 1e-6) << i;
+  }
+  ASSERT_EQ(late["wounds"].size(), 1u) << (late.contains("cut_error") ? late["cut_error"].dump() : "");
+  EXPECT_NEAR(late["wounds"][0]["width_mm"].get<double>(), early["wounds"][0]["width_mm"].get<double>(), 1e-6);
+}
+
 TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBothAgree) {
   StudioSession session(fresh_folder("handoff"), bare_model_case(kCoarseAbdomen));
   const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];

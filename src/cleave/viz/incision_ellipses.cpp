@@ -15,22 +15,29 @@ constexpr double kSkinSnapCells = 1.5;  ///< rim points are snapped to the skin 
 
 enum class Margin { outer_at_skin, inner_at_depth };
 
-std::optional<Ellipse2> fit_margin(const BodySurface& surface, std::span<const Vec3> displacement_mm,
-                                   const IncisionFrame& frame, Margin margin) {
+std::vector<MarginSample> sample_margin(const BodySurface& surface, const IncisionFrame& frame, Margin margin) {
   const double at_depth_mm = margin == Margin::outer_at_skin ? 0.0 : frame.depth_mm;
   const LinkedVolume& volume = surface.model().volume;
   const auto body_side = [&](CellId c) { return frame.radial_of(volume.cell_center_mm(c)) > frame.radius_mm; };
-  std::vector<Eigen::Vector2d> points;
+  std::vector<MarginSample> samples;
   for (int k = 0; k < kMarginSamples; ++k) {
     Vec3 x = frame.rim_point(2 * std::numbers::pi * k / kMarginSamples, at_depth_mm);
     if (margin == Margin::outer_at_skin)
       if (const auto s = surface.project(x, kSkinSnapCells * surface.cell_size_mm())) x = s->position_mm;
-    const auto u = displacement_at_point(volume, displacement_mm, x, body_side);
-    if (!u) continue;
-    const Vec3 d = x + *u - frame.centre_mm;
+    if (const std::optional<CellPoint> at = locate_in_accepted_cell(volume, x, body_side)) samples.push_back({x, *at});
+  }
+  return samples;
+}
+
+std::optional<Ellipse2> fit_margin(const LinkedVolume& volume, const std::vector<MarginSample>& samples,
+                                   std::span<const Vec3> displacement_mm, const IncisionFrame& frame) {
+  if (samples.size() < static_cast<std::size_t>(kMarginSamples / 2)) return std::nullopt;
+  std::vector<Eigen::Vector2d> points;
+  points.reserve(samples.size());
+  for (const MarginSample& sample : samples) {
+    const Vec3 d = sample.position_mm + displacement_at(volume, displacement_mm, sample.at) - frame.centre_mm;
     points.emplace_back(d.dot(frame.tangent_u), d.dot(frame.tangent_v));
   }
-  if (points.size() < static_cast<std::size_t>(kMarginSamples / 2)) return std::nullopt;
   return fit_ellipse(points);
 }
 
@@ -55,11 +62,21 @@ double line_angle_deg(const Vec3& a, const Vec3& b) {
   return std::acos(std::min(1.0, c)) * 180.0 / std::numbers::pi;
 }
 
+IncisionMargins sample_incision_margins(const BodySurface& surface, const IncisionFrame& frame) {
+  return {sample_margin(surface, frame, Margin::outer_at_skin), sample_margin(surface, frame, Margin::inner_at_depth)};
+}
+
 std::optional<IncisionMeasurement> measure_incision(const BodySurface& surface, std::span<const Vec3> displacement_mm,
                                                     const IncisionFrame& frame,
                                                     const std::optional<TangentDirection>& reference) {
-  const auto outer = fit_margin(surface, displacement_mm, frame, Margin::outer_at_skin);
-  const auto inner = fit_margin(surface, displacement_mm, frame, Margin::inner_at_depth);
+  return measure_incision(surface.model().volume, sample_incision_margins(surface, frame), displacement_mm, frame, reference);
+}
+
+std::optional<IncisionMeasurement> measure_incision(const LinkedVolume& volume, const IncisionMargins& margins,
+                                                    std::span<const Vec3> displacement_mm, const IncisionFrame& frame,
+                                                    const std::optional<TangentDirection>& reference) {
+  const auto outer = fit_margin(volume, margins.outer, displacement_mm, frame);
+  const auto inner = fit_margin(volume, margins.inner, displacement_mm, frame);
   if (!outer || !inner) return std::nullopt;
   IncisionMeasurement m;
   m.outer = *outer;

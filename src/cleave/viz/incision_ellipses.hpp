@@ -10,15 +10,23 @@
 //   IncisionMeasurement m = *measure_incision(surface, displacement_mm, frame, reference);
 //   m.outer.axis_ratio(), m.outer.semi_major, m.gap_mm, m.langer_angle_deg
 //
+// The samples (where each sits on the reference body, in which body-side cell) do not depend on
+// the displacement: sample them once per cut body and measure every later displacement with them
+// (the studio measures its 53 preview incisions after every edit):
+//   IncisionMargins margins = sample_incision_margins(surface, frame);
+//   m = *measure_incision(volume, margins, displacement_mm, frame, reference);
+//
 // The reference direction is the designed Langer direction at the incision, or, without a
 // design, the major principal direction of the residual stress in the tangent plane
 // (principal_tangent_direction). Returns nullopt when the margins cannot be sampled (no body
 // cell next to the wall) or no ellipse fits.
 #include <optional>
 #include <span>
+#include <vector>
 
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/cut/round_incision_links.hpp"
+#include "cleave/viz/displacement_at_point.hpp"
 #include "cleave/viz/ellipse_fit.hpp"
 
 namespace cleave {
@@ -46,8 +54,28 @@ struct IncisionMeasurement {
 /// Number of points sampled on each margin.
 inline constexpr int kMarginSamples = 72;
 
+/// One margin sample: its position on the reference body (the ideal circle, the outer one snapped
+/// to the skin) and where it sits in the body-side cell whose displacement moves it.
+struct MarginSample {
+  Vec3 position_mm = Vec3::Zero();
+  CellPoint at;
+};
+
+/// The samples of an incision's outer and inner margin (those with a body-side cell next to them).
+struct IncisionMargins {
+  std::vector<MarginSample> outer, inner;
+};
+
+IncisionMargins sample_incision_margins(const BodySurface& surface, const IncisionFrame& frame);
+
+/// Samples the margins on `surface` and measures them under `displacement_mm`.
 std::optional<IncisionMeasurement> measure_incision(const BodySurface& surface, std::span<const Vec3> displacement_mm,
                                                     const IncisionFrame& frame,
+                                                    const std::optional<TangentDirection>& reference);
+
+/// Measures margins sampled before on the same body (`volume`: its cells and vertices).
+std::optional<IncisionMeasurement> measure_incision(const LinkedVolume& volume, const IncisionMargins& margins,
+                                                    std::span<const Vec3> displacement_mm, const IncisionFrame& frame,
                                                     const std::optional<TangentDirection>& reference);
 
 /// Angle (degrees, in [0, 90]) between two undirected lines.
