@@ -5,6 +5,7 @@
 #include <fmt/format.h>
 #include <future>
 #include <random>
+#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
@@ -24,6 +25,7 @@
 #include "studio/cut_face_values.hpp"
 #include "studio/finite_message.hpp"
 #include "studio/packed_array.hpp"
+#include "studio/surface_residual.hpp"
 #include "studio/wire_message.hpp"
 
 namespace cleave::studio {
@@ -67,26 +69,6 @@ std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const
     for (SurfaceVertexId v : surface.triangles[static_cast<std::size_t>(i)]) triangles.push_back(static_cast<std::uint32_t>(v));
   }
   return triangles;
-}
-
-/// The equilibrium residual |T sigma| / h^2 (kPa) at each surface vertex: the force left at the
-/// uncut model's vertex of the surface vertex's grid corner, as a stress; 0 at `held` vertices
-/// (their force is the support's reaction).
-std::vector<float> residual_per_surface_vertex(const LinkedVolume& volume, const SparseMatrix& divergence,
-                                               std::span<const Vec6> stress_kPa, const RenderSurface& surface,
-                                               std::span<const VertexId> held) {
-  Vector force = divergence * flatten_stress(stress_kPa);
-  for (VertexId v : held) force.segment<3>(3 * static_cast<Eigen::Index>(v)).setZero();  // reactions, not residuals
-  const double h = volume.grid().cell_size_mm;
-  std::vector<float> out(static_cast<std::size_t>(surface.vertex_count()), 0.0f);
-  for (std::size_t v = 0; v < out.size(); ++v) {
-    for (VertexId w : volume.cell_vertices(surface.cell[v])) {
-      if (volume.vertex_grid_corner(w) != surface.grid_corner[v]) continue;
-      out[v] = static_cast<float>(force.segment<3>(3 * static_cast<Eigen::Index>(w)).norm() / (h * h));
-      break;
-    }
-  }
-  return out;
 }
 
 }  // namespace
