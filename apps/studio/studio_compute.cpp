@@ -5,7 +5,6 @@
 #include <fmt/format.h>
 #include <future>
 #include <random>
-#include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
