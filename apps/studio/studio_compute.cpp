@@ -221,6 +221,7 @@ bool StudioCompute::cut_model(const CutRequests& requests, const std::string& ke
   // Measurements sample the margins on the cut body's own surface (its split vertices).
   // Their sample points do not depend on the displacement: sampled once per cut body.
   incision_margins_.clear();
+  surface_residuals_.clear();  // per vertex of the render surface being replaced
   if (!plan_.incisions.empty()) {
     const BodySurface cut_body_surface(*preview_model_);
     incision_margins_.resize(plan_.incisions.size());
@@ -401,7 +402,14 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   }
   if (has_stress) {
     if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
-    f["residual_kPa"] = packed_floats(residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices));
+    // An edit back to a recent design gives the same stress on the same surface: the same values.
+    const std::vector<float>* residual = surface_residuals_.find(stress_kPa_);
+    if (residual == nullptr) {
+      surface_residuals_.remember(stress_kPa_, residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface,
+                                                                           design_settings_.held_vertices));
+      residual = surface_residuals_.find(stress_kPa_);
+    }
+    f["residual_kPa"] = packed_floats(*residual);
   }
   if (!displacement_mm_.empty()) f["displacement_mm"] = packed_floats(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).

@@ -10,6 +10,7 @@
 #include <string>
 #include <vector>
 
+#include "cleave/core/recent_results.hpp"
 #include "cleave/cut/body_surface.hpp"
 #include "cleave/cut/cut_plan.hpp"
 #include "cleave/fem/static_solver.hpp"
@@ -77,6 +78,8 @@ class StudioCompute {
   std::vector<Vec3> normal_axes_;
   DesignResult directions_only_;
   SparseMatrix divergence_;                           ///< T of the uncut model, for the residual display
+  /// The residual display of the last two stresses on preview_surface_ (cleared with it).
+  RecentResults<std::vector<Vec6>, std::vector<float>> surface_residuals_{2};
   std::string cut_key_;                               ///< what preview_model_ was cut with
   /// Names preview_surface_ in the messages ("surface"/"id"): this server's random token and a
   /// count of the surfaces built, so a page never takes another server's triangles for these.

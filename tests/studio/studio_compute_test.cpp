@@ -235,6 +235,11 @@ TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) 
     EXPECT_NEAR(late["incisions"][i]["opening_mm"].get<double>(), early["incisions"][i]["opening_mm"].get<double>(), 1e-6) << i;
     EXPECT_NEAR(late["incisions"][i]["axis_ratio"].get<double>(), early["incisions"][i]["axis_ratio"].get<double>(), 1e-6) << i;
   }
+  // The cut keeps the designed stress but changes the surface: the residual display remembered
+  // for that stress on the uncut surface must not be reused (one value per vertex of this surface).
+  const std::size_t surface_vertices = unpacked_floats(late["surface"]["positions_mm"]).size() / 3;
+  EXPECT_EQ(unpacked_floats(late["fields"]["residual_kPa"]).size(), surface_vertices);
+  EXPECT_EQ(unpacked_floats(late["fields"]["residual_kPa"]), unpacked_floats(early["fields"]["residual_kPa"]));
   ASSERT_EQ(late["wounds"].size(), 1u) << (late.contains("cut_error") ? late["cut_error"].dump() : "");
   EXPECT_NEAR(late["wounds"][0]["width_mm"].get<double>(), early["wounds"][0]["width_mm"].get<double>(), 1e-6);
 }
