@@ -117,9 +117,9 @@ TEST(EigenvalueField, BadControlPointsAreRefused) {
             "eigenvalues (kPa), without which the stress would silently be zero");
   EXPECT_EQ(message({{{50, 50, 40}, 20, 10}}),
             "design control point 0 at (50, 50, 40) mm is 30.1 mm from the body surface; expected within 5 mm");
-  EXPECT_EQ(message({{{50, 50, 10}, NAN, 10}}),
+  EXPECT_EQ(message({{{50, 50, 10}, std::numeric_limits<double>::quiet_NaN(), 10}}),
             "design control point 0 eigenvalues (nan, 10) are not finite; expected stresses in kPa");
-  EXPECT_EQ(message({{{50, INFINITY, 10}, 20, 10}}), "design control point 0 position is not finite; expected coordinates in mm");
+  EXPECT_EQ(message({{{50, std::numeric_limits<double>::infinity(), 10}, 20, 10}}), "design control point 0 position is not finite; expected coordinates in mm");
 }
 
 }  // namespace

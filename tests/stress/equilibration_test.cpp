@@ -253,7 +253,7 @@ TEST(Equilibration, ABalancedFieldIsLeftAsItIs) {
   EXPECT_EQ(r.refinement_steps, 0);
   for (const Vec6& s : r.stress_kPa) EXPECT_EQ(s, Vec6::Zero());
   std::vector<Vec6> bad = zero;
-  bad[3][0] = NAN;
+  bad[3][0] = std::numeric_limits<double>::quiet_NaN();
   EXPECT_THROW(equilibrate_stress(m, bad), InputError);
 }
 
