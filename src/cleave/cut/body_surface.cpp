@@ -42,7 +42,7 @@ double BodySurface::field_mm(const Vec3& p_mm) const {
   double value = 0;
   for (int c = 0; c < kCornerCount; ++c) {
     const Vec3i o = corner_offset(c);
-    const double w = (o.x() ? t.x() : 1 - t.x()) * (o.y() ? t.y() : 1 - t.y()) * (o.z() ? t.z() : 1 - t.z());
+    const double w = trilinear_corner_weight(c, t);
     value += w * static_cast<double>(model_.labels.corner_distance_mm[static_cast<std::size_t>(grid.corner_index(base + o))]);
   }
   return value + outside_mm;

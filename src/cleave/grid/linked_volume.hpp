@@ -29,6 +29,11 @@ inline constexpr Face opposite(Face f) { return f ^ 1; }
 Vec3i face_step(Face f);
 /// Offset (0/1 per axis) of corner c from the cell's voxel coordinates.
 inline Vec3i corner_offset(int c) { return {c & 1, (c >> 1) & 1, (c >> 2) & 1}; }
+/// Trilinear weight of corner c at local coordinates t (each in [0, 1]) of a cell.
+inline double trilinear_corner_weight(int c, const Vec3& t) {
+  const Vec3i o = corner_offset(c);
+  return (o.x() ? t.x() : 1 - t.x()) * (o.y() ? t.y() : 1 - t.y()) * (o.z() ? t.z() : 1 - t.z());
+}
 /// The 4 corners (cell-local indices) lying on face f.
 std::array<int, 4> face_corners(Face f);
 

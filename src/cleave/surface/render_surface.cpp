@@ -257,11 +257,8 @@ std::vector<Vec3> deformed_positions(const RenderSurface& surface, const LinkedV
     const Vec3& t = surface.xi[i];
     const auto& vertices = volume.cell_vertices(surface.cell[i]);
     Vec3 u = Vec3::Zero();
-    for (int k = 0; k < kCornerCount; ++k) {
-      const Vec3i o = corner_offset(k);
-      const double w = (o.x() ? t.x() : 1 - t.x()) * (o.y() ? t.y() : 1 - t.y()) * (o.z() ? t.z() : 1 - t.z());
-      u += w * displacement_mm[static_cast<size_t>(vertices[static_cast<size_t>(k)])];
-    }
+    for (int k = 0; k < kCornerCount; ++k)
+      u += trilinear_corner_weight(k, t) * displacement_mm[static_cast<size_t>(vertices[static_cast<size_t>(k)])];
     positions[i] = surface.reference_mm[i] + u;
   }
   return positions;

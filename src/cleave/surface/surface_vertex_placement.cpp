@@ -29,7 +29,7 @@ double SurfaceField::sample_mm(const Vec3& p_mm) const {
   double value = 0;
   for (int c = 0; c < kCornerCount; ++c) {
     const Vec3i o = corner_offset(c);
-    const double w = (o.x() ? t.x() : 1 - t.x()) * (o.y() ? t.y() : 1 - t.y()) * (o.z() ? t.z() : 1 - t.z());
+    const double w = trilinear_corner_weight(c, t);
     value += w * static_cast<double>((*corner_mm)[static_cast<size_t>(g.corner_index(base + o))]);
   }
   return value;

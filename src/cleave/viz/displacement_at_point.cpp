@@ -37,10 +37,7 @@ std::optional<CellPoint> locate_in_accepted_cell(const LinkedVolume& volume, con
                      .cwiseMin(Vec3::Ones());
   CellPoint at;
   at.cell = c;
-  for (int k = 0; k < kCornerCount; ++k) {
-    const Vec3i o = corner_offset(k);
-    at.weights[static_cast<std::size_t>(k)] = (o.x() ? t.x() : 1 - t.x()) * (o.y() ? t.y() : 1 - t.y()) * (o.z() ? t.z() : 1 - t.z());
-  }
+  for (int k = 0; k < kCornerCount; ++k) at.weights[static_cast<std::size_t>(k)] = trilinear_corner_weight(k, t);
   return at;
 }
 
