@@ -403,13 +403,14 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   if (has_stress) {
     if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
     // An edit back to a recent design gives the same stress on the same surface: the same values.
-    const std::vector<float>* residual = surface_residuals_.find(stress_kPa_);
-    if (residual == nullptr) {
-      surface_residuals_.remember(stress_kPa_, residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface,
-                                                                           design_settings_.held_vertices));
-      residual = surface_residuals_.find(stress_kPa_);
+    if (const std::vector<float>* known = surface_residuals_.find(stress_kPa_)) {
+      f["residual_kPa"] = packed_floats(*known);
+    } else {
+      std::vector<float> residual =
+          residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices);
+      f["residual_kPa"] = packed_floats(residual);
+      surface_residuals_.remember(stress_kPa_, std::move(residual));
     }
-    f["residual_kPa"] = packed_floats(*residual);
   }
   if (!displacement_mm_.empty()) f["displacement_mm"] = packed_floats(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).

@@ -42,5 +42,23 @@ TEST(RecentResults, FindsOnlyEqualInputsAndForgetsTheOldestPastItsCapacity) {
   EXPECT_EQ(recent.find(b), nullptr);
 }
 
+TEST(RecentResults, RenewMakesTheEntryFoundTheNewest) {
+  RecentResults<std::vector<double>, std::string> recent(2);
+  const std::vector<double> a{1.0}, b{2.0}, c{3.0};
+  recent.remember(a, "a");
+  recent.remember(b, "b");
+  EXPECT_EQ(recent.renew(c), nullptr);
+  const std::string* renewed = recent.renew(a);
+  ASSERT_NE(renewed, nullptr);
+  EXPECT_EQ(*renewed, "a");
+  recent.remember(c, "c");  // b is the oldest now and goes, not a
+  EXPECT_EQ(recent.size(), 2U);
+  EXPECT_EQ(recent.find(b), nullptr);
+  const std::string* kept = recent.find(a);
+  ASSERT_NE(kept, nullptr);
+  EXPECT_EQ(*kept, "a");
+  EXPECT_NE(recent.find(c), nullptr);
+}
+
 }  // namespace
 }  // namespace cleave

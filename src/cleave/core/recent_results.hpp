@@ -15,6 +15,7 @@
 #include <algorithm>
 #include <cstddef>
 #include <deque>
+#include <iterator>
 #include <ranges>
 #include <utility>
 
@@ -31,6 +32,16 @@ class RecentResults {
     for (const Entry& e : entries_)
       if (same(e.key, probe)) return &e.result;
     return nullptr;
+  }
+
+  /// find, and the entry found becomes the newest (without copying it): a result recalled now
+  /// stays among the last ones when the next new result is remembered.
+  template <typename Probe>
+  const Result* renew(const Probe& probe) {
+    const auto it = std::find_if(entries_.begin(), entries_.end(), [&](const Entry& e) { return same(e.key, probe); });
+    if (it == entries_.end()) return nullptr;
+    std::rotate(entries_.begin(), it, std::next(it));
+    return &entries_.front().result;
   }
 
   /// Remembers `result` for `key` as the newest entry (an equal key's older entry is replaced).

@@ -139,14 +139,14 @@ void StressDesigner::set_design(StressDesign design) {
   if (a.laplacian != b.laplacian || a.constraint != b.constraint || a.equilibrium != b.equilibrium ||
       design.snap_tolerance_cells != design_.snap_tolerance_cells || design.held_vertices != design_.held_vertices)
     throw InputError("design weights, snap tolerance or held vertices changed; expected the same (build a new StressDesigner)");
-  if (const DesignResult* known = recent_.find(key_of(design))) {
+  // renew: the recalled design becomes the newest again, so the last two are it and the next edit's.
+  if (const DesignResult* known = recent_.renew(key_of(design))) {
     result_ = *known;
     result_.remembered = true;
     result_.timings = {};
     result_.eigenvalue_iterations = 0;
     result_.equilibration_iterations = 0;
     design_ = std::move(design);
-    recent_.remember(key_of(design_), result_);  // the newest again: the last two are it and the next edit's
     return;
   }
   // Work on a copy: a failing edit leaves the designer as it was.
