@@ -105,8 +105,8 @@ TEST_P(AbdomenEquilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest)
   d.equilibration = Equilibration::growth;
   const DesignResult result = design_residual_stress(m, d);
 
-  // The equilibration stops at ||T sigma|| <= 1e-11 ||T sigma_d|| (its rounding floor is near
-  // 1e-12): measured 1.2e-11 (w_E = 0) and 3.7e-12 (w_E = 1) in this scale-free measure (2.05e-12
+  // The equilibration stops at ||T sigma|| <= 5e-11 ||T sigma_d|| (its rounding floor lies between
+  // 1e-12 and 5e-11): measured 1.2e-11 (w_E = 0) and 3.7e-12 (w_E = 1) in this scale-free measure (2.05e-12
   // with w_E = 1 while it iterated to the floor); the body's rest and Hoger's mean are checked below.
   EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 5e-11 : 1e-11);
   EXPECT_GT(result.residual_designed, 1e-2);
@@ -153,7 +153,7 @@ TEST(Equilibration, WithTheRimHeldTheSkinKeepsItsLangerTension) {
   for (VertexId v = 0; v < m.volume.vertex_count(); ++v)
     if (!held[static_cast<std::size_t>(v)]) free_force = std::max(free_force, forces.segment<3>(3 * v).cwiseAbs().maxCoeff());
   EXPECT_LT(free_force, 1e-9 * designed_forces.cwiseAbs().maxCoeff());
-  EXPECT_LT(result.residual_final, 1e-11);  // measured 3.7e-12 (the stopping rule: 1e-11 of ||T sigma_d||)
+  EXPECT_LT(result.residual_final, 1e-11);  // measured 3.7e-12 (the stopping rule: 5e-11 of ||T sigma_d||)
   const double size = m.size_mm();
   EXPECT_GT(max_displacement_mm(m, result.designed_kPa, d.held_vertices), 1e-2 * size);
   EXPECT_LT(max_displacement_mm(m, result.stress_kPa, d.held_vertices), 1e-6 * size);

@@ -18,7 +18,7 @@
 // gradients on Kc itself: the few eigenvalues of the preconditioned operator that are not close
 // to 1 (soft and near-hourglass modes) are what CG removes in a handful of iterations. The best
 // iterate is kept, since rounding in the null space makes CG drift after convergence; the solve
-// stops at ||T sigma|| <= 1e-11 ||T sigma_d|| (the rounding floor is near 1e-12).
+// stops at ||T sigma|| <= 5e-11 ||T sigma_d|| (the rounding floor lies between 1e-12 and 5e-11).
 // Edits: each solve starts from the last displacement, and its first step minimizes the energy
 // over the factor's correction and the soft modes learned from earlier solves (what CG corrected
 // after its first step, Kc-orthonormal, at most 16): an edit back to an earlier design (a drag

@@ -1,0 +1,66 @@
+// Equilibration timings on the paper's 44,000-cell tube (Table 1): one StressEquilibrator, then
+// edits of a smooth designed stress that change it everywhere (no edit repeats one of the last
+// two, so each is solved). A benchmark, not a test: DISABLED_ so that it runs only on request:
+//   cleave_test_stress --gtest_also_run_disabled_tests --gtest_filter='*EquilibrationBenchmark*'
+// Environment: CLEAVE_BENCH_EDITS (default 20). Prints per-edit times and solves with the factor;
+// asserts only that every edit reached the required balance.
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <string>
+
+#include "cleave/shapes/builtin_shapes.hpp"
+#include "cleave/stress/equilibrate_stress.hpp"
+
+namespace cleave {
+namespace {
+
+using Clock = std::chrono::steady_clock;
+
+TissueModel tube_44k() {
+  ShapeResolution resolution;
+  resolution.cells = Vec3i(42, 42, 51);
+  Material m;
+  m.youngs_modulus_kPa = 3.0;
+  m.poisson_ratio = 0.45;
+  return make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
+}
+
+/// A smooth stress that is not self-balanced; `edit` shifts its waves.
+std::vector<Vec6> designed_stress(const TissueModel& model, int edit) {
+  std::vector<Vec6> out(static_cast<std::size_t>(model.volume.cell_count()));
+  const double phase = 0.1 * edit;
+  for (CellId c = 0; c < model.volume.cell_count(); ++c) {
+    const Vec3 x = model.volume.cell_center_mm(c);
+    const double a = std::sin(0.05 * x.x() + phase), b = std::cos(0.04 * x.z() - phase);
+    out[static_cast<std::size_t>(c)] << 20.0 * a, 10.0 + 5.0 * b, 3.0 * a * b, 2.0 * b, 1.0 * a, 0.5;
+  }
+  return out;
+}
+
+TEST(EquilibrationBenchmark, DISABLED_Tube44kEdits) {
+  const TissueModel model = tube_44k();
+  const char* edits_env = std::getenv("CLEAVE_BENCH_EDITS");
+  const int edits = edits_env ? std::atoi(edits_env) : 20;
+  StressEquilibrator equilibrator(model);
+  std::vector<double> ms;
+  for (int edit = 0; edit < edits; ++edit) {
+    const std::vector<Vec6> designed = designed_stress(model, edit);
+    const auto start = Clock::now();
+    const EquilibrationResult r = equilibrator.equilibrate(designed);
+    const double elapsed = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    if (edit > 0) ms.push_back(elapsed);
+    std::printf("edit %2d: %7.1f ms, %d solves, reduction %.2e\n", edit, elapsed, r.refinement_steps, r.force_reduction);
+    EXPECT_LE(r.force_reduction, 1e-10);
+  }
+  if (ms.empty()) return;
+  std::sort(ms.begin(), ms.end());
+  std::printf("median of %zu edits after the first: %.1f ms\n", ms.size(), ms[ms.size() / 2]);
+}
+
+}  // namespace
+}  // namespace cleave
