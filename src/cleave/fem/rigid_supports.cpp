@@ -2,6 +2,9 @@
 
 #include <Eigen/Dense>
 #include <cmath>
+#include <fmt/format.h>
+
+#include "cleave/core/error.hpp"
 
 namespace cleave {
 namespace {
@@ -142,32 +145,75 @@ RigidSupportReport add_rigid_supports(const LinkedVolume& volume, FixedDofs& fix
   return report;
 }
 
-void remove_rigid_motion(const LinkedVolume& volume, std::span<const int> components, const Vector& weights, Vector& u) {
-  if (components.empty()) return;
+struct RigidMotionRemover::Piece {
+  PieceFrame frame;
+  Eigen::LDLT<Mat6d> normal_equations;  ///< of the weighted least-squares fit of the 6 rigid modes
+};
+
+RigidMotionRemover::RigidMotionRemover(const LinkedVolume& volume, std::span<const int> components, Vector weights)
+    : volume_(&volume), weights_(std::move(weights)) {
+  if (weights_.size() != 3 * static_cast<Eigen::Index>(volume.vertex_count()))
+    throw InputError(fmt::format("rigid motion weights hold {} values; expected one per dof ({})", weights_.size(),
+                                 3 * static_cast<Eigen::Index>(volume.vertex_count())));
   const int pieces = volume.component_count();
+  std::vector<int> index_of_piece(static_cast<std::size_t>(pieces), -1);
+  for (const int p : components) {
+    if (p < 0 || p >= pieces)
+      throw InputError(fmt::format("component {} does not exist; expected 0 to {}", p, pieces - 1));
+    if (index_of_piece[static_cast<std::size_t>(p)] >= 0) continue;  // listed twice
+    index_of_piece[static_cast<std::size_t>(p)] = static_cast<int>(pieces_.size());
+    pieces_.emplace_back();
+  }
+  if (pieces_.empty()) return;
   const std::vector<int> comp = vertex_components(volume);
   const std::vector<PieceFrame> frames = piece_frames(volume, comp, pieces);
-  std::vector<std::uint8_t> wanted(static_cast<std::size_t>(pieces), 0);
-  for (const int p : components) wanted[static_cast<std::size_t>(p)] = 1;
-  std::vector<Mat6d> gram(static_cast<std::size_t>(pieces), Mat6d::Zero());
-  std::vector<Vec6d> moment(static_cast<std::size_t>(pieces), Vec6d::Zero());
+  piece_of_vertex_.resize(comp.size());
+  for (std::size_t v = 0; v < comp.size(); ++v) piece_of_vertex_[v] = index_of_piece[static_cast<std::size_t>(comp[v])];
+  for (int p = 0; p < pieces; ++p)
+    if (const int i = index_of_piece[static_cast<std::size_t>(p)]; i >= 0) pieces_[static_cast<std::size_t>(i)].frame = frames[static_cast<std::size_t>(p)];
+  std::vector<Mat6d> gram(pieces_.size(), Mat6d::Zero());
   for (VertexId v = 0; v < volume.vertex_count(); ++v) {
-    const auto p = static_cast<std::size_t>(comp[static_cast<std::size_t>(v)]);
-    if (!wanted[p]) continue;
-    for (int i = 0; i < 3; ++i) {
-      const Vec6d row = rigid_row(frames[p], volume.vertex_position_mm(v), i);
-      const double w = weights[3 * v + i];
-      gram[p] += w * row * row.transpose();
-      moment[p] += w * u[3 * v + i] * row;
+    const int i = piece_of_vertex_[static_cast<std::size_t>(v)];
+    if (i < 0) continue;
+    for (int axis = 0; axis < 3; ++axis) {
+      const Vec6d row = rigid_row(pieces_[static_cast<std::size_t>(i)].frame, volume.vertex_position_mm(v), axis);
+      gram[static_cast<std::size_t>(i)] += weights_[3 * v + axis] * row * row.transpose();
     }
   }
-  std::vector<Vec6d> coefficients(static_cast<std::size_t>(pieces), Vec6d::Zero());
-  for (const int p : components) coefficients[static_cast<std::size_t>(p)] = gram[static_cast<std::size_t>(p)].ldlt().solve(moment[static_cast<std::size_t>(p)]);
+  for (std::size_t i = 0; i < pieces_.size(); ++i) pieces_[i].normal_equations.compute(gram[i]);
+}
+
+RigidMotionRemover::~RigidMotionRemover() = default;
+RigidMotionRemover::RigidMotionRemover(RigidMotionRemover&&) noexcept = default;
+RigidMotionRemover& RigidMotionRemover::operator=(RigidMotionRemover&&) noexcept = default;
+
+void RigidMotionRemover::remove(Vector& u) const {
+  if (u.size() != weights_.size())
+    throw InputError(fmt::format("displacement holds {} values; expected one per dof ({})", u.size(), weights_.size()));
+  if (pieces_.empty()) return;
+  const LinkedVolume& volume = *volume_;
+  std::vector<Vec6d> moment(pieces_.size(), Vec6d::Zero());
   for (VertexId v = 0; v < volume.vertex_count(); ++v) {
-    const auto p = static_cast<std::size_t>(comp[static_cast<std::size_t>(v)]);
-    if (!wanted[p]) continue;
-    for (int i = 0; i < 3; ++i) u[3 * v + i] -= rigid_row(frames[p], volume.vertex_position_mm(v), i).dot(coefficients[p]);
+    const int i = piece_of_vertex_[static_cast<std::size_t>(v)];
+    if (i < 0) continue;
+    for (int axis = 0; axis < 3; ++axis)
+      moment[static_cast<std::size_t>(i)] += weights_[3 * v + axis] * u[3 * v + axis] *
+                                             rigid_row(pieces_[static_cast<std::size_t>(i)].frame, volume.vertex_position_mm(v), axis);
   }
+  std::vector<Vec6d> coefficients(pieces_.size());
+  for (std::size_t i = 0; i < pieces_.size(); ++i) coefficients[i] = pieces_[i].normal_equations.solve(moment[i]);
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    const int i = piece_of_vertex_[static_cast<std::size_t>(v)];
+    if (i < 0) continue;
+    const Piece& piece = pieces_[static_cast<std::size_t>(i)];
+    for (int axis = 0; axis < 3; ++axis)
+      u[3 * v + axis] -= rigid_row(piece.frame, volume.vertex_position_mm(v), axis).dot(coefficients[static_cast<std::size_t>(i)]);
+  }
+}
+
+void remove_rigid_motion(const LinkedVolume& volume, std::span<const int> components, const Vector& weights, Vector& u) {
+  if (components.empty()) return;
+  RigidMotionRemover(volume, components, weights).remove(u);
 }
 
 }  // namespace cleave

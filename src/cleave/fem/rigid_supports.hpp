@@ -26,6 +26,32 @@ RigidSupportReport add_rigid_supports(const LinkedVolume& volume, FixedDofs& fix
 /// piece's weighted mean displacement and mean infinitesimal rotation are zero.
 void remove_rigid_motion(const LinkedVolume& volume, std::span<const int> components, const Vector& weights, Vector& u);
 
+/// remove_rigid_motion for many displacements of one volume (a StaticSolver's solves): the
+/// vertices' pieces, the pieces' frames and their weighted normal equations are set up once, so
+/// that each removal is one pass over the listed pieces' vertices.
+///
+///   RigidMotionRemover remover(volume, free_components, lumped_mass(model));
+///   remover.remove(u);  // as remove_rigid_motion(volume, free_components, mass, u)
+class RigidMotionRemover {
+ public:
+  /// The volume must keep its topology and positions while the remover is used. InputError for
+  /// weights that are not one per dof or components that do not exist.
+  RigidMotionRemover(const LinkedVolume& volume, std::span<const int> components, Vector weights);
+  ~RigidMotionRemover();
+  RigidMotionRemover(RigidMotionRemover&&) noexcept;
+  RigidMotionRemover& operator=(RigidMotionRemover&&) noexcept;
+
+  /// InputError when `u` does not hold one value per dof.
+  void remove(Vector& u) const;
+
+ private:
+  struct Piece;
+  const LinkedVolume* volume_;
+  std::vector<int> piece_of_vertex_;  ///< index into pieces_; -1 where the vertex's piece is left alone
+  std::vector<Piece> pieces_;
+  Vector weights_;
+};
+
 /// Component of every vertex (the component of its cells).
 std::vector<int> vertex_components(const LinkedVolume& volume);
 

@@ -68,7 +68,8 @@ StaticResult StaticSolver::solve_once(std::span<const Vec6> residual_stress_kPa)
   result.report = solver_->solve(f, u);
   ++solves_;
   require_converged(result.report, solver_->name(), options_.settings, "static solve");
-  remove_rigid_motion(volume, supports_.free_components, lumped_mass(model_), u);
+  if (!rigid_motion_) rigid_motion_.emplace(volume, supports_.free_components, lumped_mass(model_));
+  rigid_motion_->remove(u);
   if (!u.allFinite()) throw ComputeError(fmt::format("static solve with {} produced a non-finite displacement", solver_->name()));
   for (VertexId v = 0; v < volume.vertex_count(); ++v) result.displacement_mm[static_cast<std::size_t>(v)] = u.segment<3>(3 * v);
   return result;

@@ -10,6 +10,7 @@
 //
 // The model must outlive the solver and keep its topology (no cut) while the solver is used.
 #include <memory>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -53,6 +54,7 @@ class StaticSolver {
   Vector fixed_load_;        ///< the right-hand side that elimination makes of a zero load
   FixedDofs fixed_;
   RigidSupportReport supports_;
+  std::optional<RigidMotionRemover> rigid_motion_;  ///< of the free pieces, set up at the first loaded solve
   std::unique_ptr<LinearSolver> solver_;
   bool set_up_ = false;
   int solves_ = 0;
