@@ -8,6 +8,7 @@
 #include "cleave/core/error.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
+#include "cleave/grid/vertex_corner_slots.hpp"
 #include "cleave/solve/block_jacobi.hpp"
 
 namespace cleave {
@@ -24,18 +25,10 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   const auto cells = static_cast<std::size_t>(volume.cell_count());
   material_.resize(cells);
   for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
-  const auto& around = volume.vertex_cells();
-  vertex_start_.assign(around.size() + 1, 0);
-  for (std::size_t v = 0; v < around.size(); ++v) vertex_start_[v + 1] = vertex_start_[v] + static_cast<std::int32_t>(around[v].size());
-  vertex_slot_.resize(static_cast<std::size_t>(vertex_start_.back()));
-  for (std::size_t v = 0; v < around.size(); ++v)
-    for (std::size_t t = 0; t < around[v].size(); ++t) {
-      const CellId c = around[v][t];
-      const auto& corners = volume.cell_vertices(c);
-      int a = 0;
-      while (corners[static_cast<std::size_t>(a)] != static_cast<VertexId>(v)) ++a;
-      vertex_slot_[static_cast<std::size_t>(vertex_start_[v]) + t] = 24 * static_cast<std::int32_t>(c) + a;
-    }
+  VertexCornerSlots slots = vertex_corner_slots(volume);
+  vertex_start_ = std::move(slots.start);
+  vertex_slot_ = std::move(slots.slot);
+  for (std::int32_t& slot : vertex_slot_) slot = 24 * (slot / kCornerCount) + slot % kCornerCount;  // the cell's x values
   rotations_ = {};
 }
 

@@ -10,9 +10,8 @@
 #include "cleave/core/error.hpp"
 #include "cleave/core/recent_results.hpp"
 #include "cleave/fem/element_table.hpp"
-#include "cleave/fem/hex8_element.hpp"
 #include "cleave/fem/residual_stress_forces.hpp"
-#include "cleave/solve/sparse_multiply.hpp"
+#include "cleave/stress/centre_point_stiffness.hpp"
 #include "cleave/stress/sparse_cholesky.hpp"
 
 namespace cleave {
@@ -47,11 +46,21 @@ constexpr double kDependentDirection = 1e-12;  ///< relative eigenvalue of the s
 
 }  // namespace
 
+/// Per dof: 1 where the vertex is held (Gamma_D). InputError for ids out of range.
+std::vector<std::uint8_t> held_dof_flags(const LinkedVolume& volume, std::span<const VertexId> held_vertices) {
+  std::vector<std::uint8_t> held(3 * static_cast<std::size_t>(volume.vertex_count()), 0);
+  for (const VertexId v : held_vertices) {
+    if (v < 0 || v >= volume.vertex_count())
+      throw InputError(fmt::format("held vertex {} does not exist; expected 0 to {}", v, volume.vertex_count() - 1));
+    for (int i = 0; i < 3; ++i) held[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(i)] = 1;
+  }
+  return held;
+}
+
 struct StressEquilibrator::Impl {
   const TissueModel& model;
-  Mat6x24 bc;
-  ElementTable table;
-  SparseMatrix kc;  ///< symmetric: rows and columns alike
+  std::vector<std::uint8_t> held_dof;  ///< per dof: 1 = vertex held (Gamma_D)
+  CentrePointStiffness kc;             ///< applied cell by cell; assembled only to factorize
   SparseCholesky cholesky;
   // Soft modes: directions that the factor of Kc + eps I misses (near-hourglass and bending modes
   // with energies near eps), learned from what CG corrected after its first step in earlier
@@ -66,17 +75,9 @@ struct StressEquilibrator::Impl {
     Vector u;
   };
   RecentResults<std::vector<Vec6>, Known> recent{kRememberedDesigns};
-  std::vector<std::uint8_t> held_dof;  ///< per dof: 1 = vertex held (Gamma_D)
 
   Impl(const TissueModel& m, std::span<const VertexId> held_vertices)
-      : model(m), bc(hex8_strain_matrix(Vec3::Constant(0.5), m.volume.grid().cell_size_mm)), table(make_element_table(m)) {
-    held_dof.assign(3 * static_cast<std::size_t>(m.volume.vertex_count()), 0);
-    for (const VertexId v : held_vertices) {
-      if (v < 0 || v >= m.volume.vertex_count())
-        throw InputError(fmt::format("held vertex {} does not exist; expected 0 to {}", v, m.volume.vertex_count() - 1));
-      for (int i = 0; i < 3; ++i) held_dof[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(i)] = 1;
-    }
-  }
+      : model(m), held_dof(held_dof_flags(m.volume, held_vertices)), kc(m.volume, make_element_table(m), held_dof) {}
 
   /// Zeroes the entries of held dofs (their forces are reactions).
   void mask(Vector& forces) const {
@@ -84,40 +85,15 @@ struct StressEquilibrator::Impl {
       if (held_dof[static_cast<std::size_t>(d)]) forces[d] = 0.0;
   }
 
+  /// Factorizes Kc + eps I (the assembled matrix is dropped afterwards: products run cell by cell).
   void factorize() {
-    const LinkedVolume& volume = model.volume;
-    const double h = volume.grid().cell_size_mm;
-    std::vector<Mat24> kc_per_material;
-    for (const ElementMatrices& m : table.per_material) kc_per_material.push_back(h * h * h * bc.transpose() * m.elasticity_kPa * bc);
-    const Eigen::Index dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
-    std::vector<Eigen::Triplet<double>> entries;
-    entries.reserve(static_cast<std::size_t>(volume.cell_count()) * 24 * 24);
-    for (CellId c = 0; c < volume.cell_count(); ++c) {
-      const Mat24& ke = kc_per_material[static_cast<std::size_t>(table.slot_of_label[volume.cell_label(c)])];
-      const auto& corners = volume.cell_vertices(c);
-      for (int a = 0; a < kCornerCount; ++a)
-        for (int b = 0; b < kCornerCount; ++b)
-          for (int i = 0; i < 3; ++i)
-            for (int j = 0; j < 3; ++j)
-              entries.emplace_back(3 * corners[static_cast<std::size_t>(a)] + i, 3 * corners[static_cast<std::size_t>(b)] + j,
-                                   ke(3 * a + i, 3 * b + j));
-    }
-    // Held dofs: identity rows and columns (u = 0 there).
-    std::erase_if(entries, [&](const Eigen::Triplet<double>& e) {
-      return held_dof[static_cast<std::size_t>(e.row())] || held_dof[static_cast<std::size_t>(e.col())];
-    });
-    for (Eigen::Index d = 0; d < dofs; ++d)
-      if (held_dof[static_cast<std::size_t>(d)]) entries.emplace_back(d, d, 1.0);
-    kc.resize(dofs, dofs);
-    kc.setFromTriplets(entries.begin(), entries.end());
-    kc.makeCompressed();
-    const double shift = kShiftOfMeanDiagonal * kc.diagonal().mean();
-    Eigen::SparseMatrix<double> shifted = kc;
+    Eigen::SparseMatrix<double> shifted = kc.assembled();
+    const double shift = kShiftOfMeanDiagonal * shifted.diagonal().mean();
     shifted.diagonal().array() += shift;  // every diagonal entry exists (each vertex has a cell)
     cholesky.factorize(shifted);
-    u = Vector::Zero(dofs);
-    soft_modes.resize(dofs, 0);
-    kc_soft_modes.resize(dofs, 0);
+    u = Vector::Zero(kc.rows());
+    soft_modes.resize(kc.rows(), 0);
+    kc_soft_modes.resize(kc.rows(), 0);
     factorized = true;
   }
 
@@ -127,13 +103,13 @@ struct StressEquilibrator::Impl {
   int solve(const Vector& b) {
     const double b_norm = b.norm();
     Vector r;
-    residual(kc, b, u, r);
+    kc.residual(b, u, r);
     Vector best = u;
     double best_norm = r.norm();
     if (best_norm <= kTargetReduction * b_norm) return 0;
     Vector z = cholesky.solve(r);
     Vector kz;
-    multiply(kc, z, kz);
+    kc.multiply(z, kz);
     two_level_step(z, kz, r);
     int iterations = 1;
     double r_norm = r.norm();
@@ -151,7 +127,7 @@ struct StressEquilibrator::Impl {
     double rz = r.dot(z);
     Vector kp;
     while (iterations < kMaxIterations) {
-      multiply(kc, p, kp);
+      kc.multiply(p, kp);
       const double curvature = p.dot(kp);
       if (!(curvature > 0.0) || !(rz > 0.0)) break;
       const double alpha = rz / curvature;
@@ -218,7 +194,7 @@ struct StressEquilibrator::Impl {
   /// normalized) to the soft modes; the oldest is dropped beyond kMaxSoftModes.
   void learn_soft_mode(Vector mode) {
     Vector kc_mode;
-    multiply(kc, mode, kc_mode);
+    kc.multiply(mode, kc_mode);
     const double energy = mode.dot(kc_mode);
     if (!(energy > 0.0) || !std::isfinite(energy)) return;
     for (int pass = 0; pass < 2 && soft_modes.cols() > 0; ++pass) {  // twice: Gram-Schmidt in rounding
@@ -275,13 +251,8 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
   if (!impl_->factorized) impl_->factorize();
   result.refinement_steps = impl_->solve(-load);
 
-  const Vector& u = impl_->u;
+  impl_->kc.add_stress(impl_->u, result.stress_kPa);
   for (CellId c = 0; c < volume.cell_count(); ++c) {
-    Vec24 ue;
-    const auto& corners = volume.cell_vertices(c);
-    for (int a = 0; a < kCornerCount; ++a) ue.segment<3>(3 * a) = u.segment<3>(3 * corners[static_cast<std::size_t>(a)]);
-    const Mat6& d = impl_->table.of_label(volume.cell_label(c)).elasticity_kPa;
-    result.stress_kPa[static_cast<std::size_t>(c)] += d * (impl_->bc * ue);
     if (!result.stress_kPa[static_cast<std::size_t>(c)].allFinite()) {
       impl_->u.setZero();  // do not warm-start the next call from a failed solve
       throw ComputeError(fmt::format("stress equilibration: the stress of cell {} is not finite after {} preconditioned CG "
