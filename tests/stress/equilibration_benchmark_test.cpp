@@ -1,9 +1,9 @@
 // Equilibration timings on the paper's 44,000-cell tube (Table 1): one StressEquilibrator, then
 // edits of a smooth designed stress that change it everywhere (no edit repeats one of the last
-// two, so each is solved). A benchmark, not a test: DISABLED_ so that it runs only on request:
+// two, so each is solved), and one product with Kc. Benchmarks, not tests: DISABLED_ so that it runs only on request:
 //   cleave_test_stress --gtest_also_run_disabled_tests --gtest_filter='*EquilibrationBenchmark*'
 // Environment: CLEAVE_BENCH_EDITS (default 20). Prints per-edit times and solves with the factor;
-// asserts only that every edit reached the required balance.
+// asserts only that every edit reached the required balance and that the products agree.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -13,7 +13,10 @@
 #include <cstdlib>
 #include <string>
 
+#include "cleave/fem/element_table.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
+#include "cleave/solve/sparse_multiply.hpp"
+#include "cleave/stress/centre_point_stiffness.hpp"
 #include "cleave/stress/equilibrate_stress.hpp"
 
 namespace cleave {
@@ -40,6 +43,37 @@ std::vector<Vec6> designed_stress(const TissueModel& model, int edit) {
     out[static_cast<std::size_t>(c)] << 20.0 * a, 10.0 + 5.0 * b, 3.0 * a * b, 2.0 * b, 1.0 * a, 0.5;
   }
   return out;
+}
+
+/// Median wall time (ms) of 31 calls.
+template <typename Work>
+double median_ms(Work&& work) {
+  std::vector<double> ms;
+  for (int i = 0; i < 31; ++i) {
+    const auto start = Clock::now();
+    work();
+    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
+  }
+  std::sort(ms.begin(), ms.end());
+  return ms[ms.size() / 2];
+}
+
+// One product with Kc: cell by cell (CentrePointStiffness) against its assembled matrix (CSR on
+// all cores, as the equilibration multiplied before).
+TEST(EquilibrationBenchmark, DISABLED_Tube44kProducts) {
+  const TissueModel model = tube_44k();
+  const std::vector<std::uint8_t> free(3 * static_cast<std::size_t>(model.volume.vertex_count()), 0);
+  const CentrePointStiffness kc(model.volume, make_element_table(model), free);
+  const SparseMatrix assembled = kc.assembled();
+  const Vector x = Vector::Random(kc.rows());
+  Vector y, z;
+  for (int round = 0; round < 3; ++round) {
+    const double cell_ms = median_ms([&] { kc.multiply(x, y); });
+    const double csr_ms = median_ms([&] { multiply(assembled, x, z); });
+    std::printf("round %d: cell by cell %.2f ms, assembled (%.0f MB) %.2f ms\n", round, cell_ms,
+                static_cast<double>(assembled.nonZeros()) * 12e-6, csr_ms);
+  }
+  EXPECT_LT((y - z).norm(), 1e-12 * z.norm());
 }
 
 TEST(EquilibrationBenchmark, DISABLED_Tube44kEdits) {
