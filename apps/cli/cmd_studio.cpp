@@ -39,6 +39,10 @@ const CommandRegistrar kStudio{
        cmd->add_option("--session", args->options.session_folder, "session folder: journal, saved cases, exports")
            ->capture_default_str();
        cmd->add_option("--web-root", args->options.web_root, "folder with the web client (index.html)")->capture_default_str();
+       cmd->add_option("--max-send-queue-mb", args->options.max_send_queue_mb,
+                       "disconnect a client whose unsent messages pass this many MB (one that stopped reading)")
+           ->capture_default_str()
+           ->check(CLI::Range(1, 65536));
        return [args] { return run_studio(*args); };
      }}};
 

@@ -86,10 +86,12 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
 
   void send(std::shared_ptr<const std::string> text) {
     if (closed_) return;
-    if (queue_.size() >= kMaxQueuedMessages) {  // a client that does not read: drop it
+    // A client that does not read: drop it before its queue holds every result since.
+    if (queue_.size() >= kMaxQueuedMessages || queued_bytes_ + text->size() > server_.options.max_queued_bytes) {
       close();
       return;
     }
+    queued_bytes_ += text->size();
     queue_.push_back(std::move(text));
     if (queue_.size() == 1) write_next();
   }
@@ -127,10 +129,11 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   void write_next() {
     ws_.binary(is_binary_wire(*queue_.front()));
     ws_.async_write(net::buffer(*queue_.front()), [self = shared_from_this()](beast::error_code ec, std::size_t) {
-      if (ec) {
+      if (ec || self->closed_) {  // closed meanwhile (queue emptied): a write that still completed
         self->close();
         return;
       }
+      self->queued_bytes_ -= self->queue_.front()->size();
       self->queue_.pop_front();
       if (!self->queue_.empty()) self->write_next();
     });
@@ -140,6 +143,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     if (closed_) return;
     closed_ = true;
     queue_.clear();
+    queued_bytes_ = 0;
     server_.clients.erase(shared_from_this());
     beast::error_code ignored;
     beast::get_lowest_layer(ws_).socket().shutdown(tcp::socket::shutdown_both, ignored);
@@ -150,6 +154,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   StudioServer::Impl& server_;
   beast::flat_buffer buffer_;
   std::deque<std::shared_ptr<const std::string>> queue_;
+  std::size_t queued_bytes_ = 0;  ///< of the messages in queue_ (the one being written included)
   bool closed_ = false;
 };
 

@@ -12,7 +12,9 @@
 //                              "state" (after every edit, to every client), "mesh", "result",
 //                              "progress" and "frame" messages (docs/studio.md)
 // Limits: request headers 8 KiB, bodies kMaxHttpBodyBytes, WebSocket messages kMaxMessageBytes;
-// a client whose send queue exceeds kMaxQueuedMessages is disconnected.
+// a client whose send queue exceeds kMaxQueuedMessages messages or ServerOptions::max_queued_bytes
+// (a client that stopped reading: results at 45k cells are ~2.5 MB each) is disconnected; the
+// others go on.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -26,11 +28,13 @@
 namespace cleave::studio {
 
 inline constexpr std::size_t kMaxQueuedMessages = 512;
+inline constexpr std::size_t kDefaultMaxQueuedBytes = std::size_t{128} << 20;
 
 struct ServerOptions {
   std::string bind_address = "127.0.0.1";  ///< numeric, checked by checked_bind_address
   std::uint16_t port = 8765;                ///< 0: any free port (see StudioServer::port)
   std::filesystem::path web_root;           ///< folder with index.html and node_modules/three
+  std::size_t max_queued_bytes = kDefaultMaxQueuedBytes;  ///< per client, messages not yet sent included
 };
 
 /// What the server asks of the computation side (studio_compute.hpp implements it).

@@ -11,6 +11,7 @@ import assert from 'node:assert/strict';
 import { spawnSync } from 'node:child_process';
 import fs from 'node:fs';
 import http from 'node:http';
+import net from 'node:net';
 import { decodeMessage } from '../../web/js/packed.js';
 import { freshSessionDir, requireTools, startServer } from './harness.mjs';
 
@@ -136,6 +137,73 @@ test('malformed, oversized and unknown messages get an error reply and the sessi
   await closed;
   assert.equal((await request(ws, { cmd: 'ping' })).type, 'pong');
   ws.close();
+});
+
+/// A WebSocket client that says hello and then stops reading: a raw TCP socket, paused.
+function openStalledClient(port) {
+  return new Promise((resolve, reject) => {
+    const socket = net.connect(port, '127.0.0.1');
+    socket.on('error', reject);
+    socket.once('connect', () => {
+      socket.write(`GET /ws HTTP/1.1\r\nHost: 127.0.0.1:${port}\r\nUpgrade: websocket\r\nConnection: Upgrade\r\n` +
+                   'Sec-WebSocket-Key: dGhlIHNhbXBsZSBub25jZQ==\r\nSec-WebSocket-Version: 13\r\n\r\n');
+      socket.once('data', (reply) => {
+        if (!/^HTTP\/1\.1 101/.test(reply.toString())) { reject(new Error(`no upgrade: ${reply}`)); return; }
+        const payload = Buffer.from(JSON.stringify({ cmd: 'hello' }));
+        const mask = Buffer.from([1, 2, 3, 4]);
+        const frame = Buffer.concat([Buffer.from([0x81, 0x80 | payload.length]), mask,
+          Buffer.from(payload.map((b, i) => b ^ mask[i % 4]))]);
+        socket.write(frame);
+        socket.pause();  // never read again
+        resolve(socket);
+      });
+    });
+  });
+}
+
+// A client that stops reading must not make the server hold every result since (2.5 MB each at
+// 45k cells): once its unsent messages pass the byte budget (--max-send-queue-mb) it is
+// disconnected; the client that reads gets every result and the server goes on.
+test('a client that stops reading is dropped at the send-queue byte budget; the others go on', { timeout: 180000 }, async () => {
+  const slow = await startServer({ bin: tools.bin, session: freshSessionDir('slow'), res: '48x16x32',
+    extraArgs: ['--max-send-queue-mb', '1'] });
+  try {
+    const stalled = await openStalledClient(slow.port);
+    let stalledClosed = false;
+    stalled.on('close', () => { stalledClosed = true; });
+    const ws = await openSocket(slow.url);
+    let results = 0;
+    let resultBytes = 0;
+    let waitResult = null;
+    ws.binaryType = 'arraybuffer';
+    ws.onpush = (m) => { if (m.type === 'result') { results++; if (waitResult) waitResult(); } };
+    const rawHandler = ws.onmessage;
+    ws.onmessage = (e) => { if (typeof e.data !== 'string') resultBytes = Math.max(resultBytes, e.data.byteLength); rawHandler(e); };
+    assert.equal((await request(ws, { cmd: 'add_control_point', position_mm: [0, 0, 0], langer_kPa: 20, cross_kPa: 10 })).type, 'ack');
+    const state = await request(ws, { cmd: 'get_state' });
+    const id = state.design.control_points[0].id;
+    // Edits until the stalled client's queue has passed the budget beyond what the kernel buffers
+    // (a few MB on loopback), at most 200.
+    let edits = 0;
+    for (; edits < 200; edits++) {
+      const arrived = new Promise((resolve) => { waitResult = resolve; });
+      const ack = await request(ws, { cmd: 'set_control_point', id, langer_kPa: 21 + (edits % 40) });
+      assert.equal(ack.type, 'ack', JSON.stringify(ack));
+      await arrived;
+      if (edits >= 8 && edits * resultBytes > (24 << 20)) break;
+    }
+    // Once resumed, the stalled client reads what the kernel held and then the server's close.
+    stalled.resume();
+    stalled.on('data', () => {});
+    const deadline = Date.now() + 20000;
+    while (!stalledClosed && Date.now() < deadline) await new Promise((r) => setTimeout(r, 100));
+    assert.ok(stalledClosed, `the stalled client was not dropped after ${edits} edits of ${resultBytes} bytes each`);
+    assert.ok(results >= edits, `the reading client got ${results} results for ${edits} edits`);
+    assert.equal((await request(ws, { cmd: 'ping' })).type, 'pong');
+    ws.close();
+  } finally {
+    await slow.stop();
+  }
 });
 
 test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknowledged edit`, { timeout: (SOAK_SECONDS + 90) * 1000 }, async () => {
