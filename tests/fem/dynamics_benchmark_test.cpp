@@ -24,34 +24,15 @@
 #include "cleave/fem/lumped_mass.hpp"
 #include "cleave/fem/stress_stiffness.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
+#include "../common/benchmark_support.hpp"
 
 namespace cleave {
 namespace {
 
 using Clock = std::chrono::steady_clock;
 
-/// The paper's 44,000-cell tube (42 x 42 x 51), soft tissue E = 3 kPa, nu = 0.45.
-TissueModel tube_44k() {
-  ShapeResolution resolution;
-  resolution.cells = Vec3i(42, 42, 51);
-  Material m;
-  m.youngs_modulus_kPa = 3.0;
-  m.poisson_ratio = 0.45;
-  return make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
-}
-
-/// Median wall time (ms) of 31 calls.
-template <typename Work>
-double median_ms(Work&& work) {
-  std::vector<double> ms;
-  for (int i = 0; i < 31; ++i) {
-    const auto t = Clock::now();
-    work();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
-}
+using test::median_ms;
+using test::tube_44k;
 
 // The step's system on the 44k tube (2 kPa tension in every cell, a small smooth displacement):
 // one product cell by cell (CorotatedSystemOperator) against the same matrix assembled as block

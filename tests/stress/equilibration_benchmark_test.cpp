@@ -15,6 +15,7 @@
 
 #include "cleave/fem/element_table.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
+#include "../common/benchmark_support.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
 #include "cleave/stress/centre_point_stiffness.hpp"
 #include "cleave/stress/equilibrate_stress.hpp"
@@ -24,14 +25,8 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-TissueModel tube_44k() {
-  ShapeResolution resolution;
-  resolution.cells = Vec3i(42, 42, 51);
-  Material m;
-  m.youngs_modulus_kPa = 3.0;
-  m.poisson_ratio = 0.45;
-  return make_tissue_model("cylinder", make_builtin_shape("cylinder", resolution), {{Label{1}, m}});
-}
+using test::median_ms;
+using test::tube_44k;
 
 /// A smooth stress that is not self-balanced; `edit` shifts its waves.
 std::vector<Vec6> designed_stress(const TissueModel& model, int edit) {
@@ -43,19 +38,6 @@ std::vector<Vec6> designed_stress(const TissueModel& model, int edit) {
     out[static_cast<std::size_t>(c)] << 20.0 * a, 10.0 + 5.0 * b, 3.0 * a * b, 2.0 * b, 1.0 * a, 0.5;
   }
   return out;
-}
-
-/// Median wall time (ms) of 31 calls.
-template <typename Work>
-double median_ms(Work&& work) {
-  std::vector<double> ms;
-  for (int i = 0; i < 31; ++i) {
-    const auto start = Clock::now();
-    work();
-    ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - start).count());
-  }
-  std::sort(ms.begin(), ms.end());
-  return ms[ms.size() / 2];
 }
 
 // One product with Kc: cell by cell (CentrePointStiffness) against its assembled matrix (CSR on
