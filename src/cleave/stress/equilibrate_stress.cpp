@@ -33,10 +33,10 @@ constexpr double kShiftOfMeanDiagonal = 1e-10;
 /// was the floor) for ~45 ms more at 44k cells and no visible physics: an imbalance of 5e-11 of the
 /// designed forces moves the body by 5e-11 of what the design would. With 1e-11 (sessions 9-17),
 /// half of the bench's tube edits and most of the harness's took that second solve.
-/// Smaller shifts (kShiftOfMeanDiagonal, above) would make the first step more accurate (1e-12: median 9e-12 on the
-/// bench's edits), but the CG steps after it then go astray on thin bodies (a 2-cell plate: 1.2e-11,
-/// 7.9e-11, then 0.12 and growing; a Ritz minimization over all corrections did no better), and
-/// 1e-11 already fails the abdomen's tests.
+/// Smaller shifts (kShiftOfMeanDiagonal, above) would make the first step more accurate (1e-12:
+/// median 9e-12 on the bench's edits), but the CG steps after it then go astray on thin bodies (a
+/// 2-cell plate: 1.2e-11, 7.9e-11, then 0.12 and growing; a Ritz minimization over all corrections
+/// did no better), and 1e-11 already fails the abdomen's tests.
 constexpr double kTargetReduction = 5e-11;
 constexpr double kRequiredReduction = 1e-10;  ///< ComputeError above this at the end
 /// Also stop, keeping the best iterate, at the first iteration that does not lower the residual
@@ -50,6 +50,8 @@ constexpr double kDependentDirection = 1e-12;  ///< relative eigenvalue of the s
 
 }  // namespace
 
+namespace {
+
 /// Per dof: 1 where the vertex is held (Gamma_D). InputError for ids out of range.
 std::vector<std::uint8_t> held_dof_flags(const LinkedVolume& volume, std::span<const VertexId> held_vertices) {
   std::vector<std::uint8_t> held(3 * static_cast<std::size_t>(volume.vertex_count()), 0);
@@ -60,6 +62,8 @@ std::vector<std::uint8_t> held_dof_flags(const LinkedVolume& volume, std::span<c
   }
   return held;
 }
+
+}  // namespace
 
 struct StressEquilibrator::Impl {
   const TissueModel& model;
