@@ -25,10 +25,9 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   const auto cells = static_cast<std::size_t>(volume.cell_count());
   material_.resize(cells);
   for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
-  VertexCornerSlots slots = vertex_corner_slots(volume);
+  VertexCornerSlots slots = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   vertex_start_ = std::move(slots.start);
   vertex_slot_ = std::move(slots.slot);
-  for (std::int32_t& slot : vertex_slot_) slot = 24 * (slot / kCornerCount) + slot % kCornerCount;  // the cell's x values
   rotations_ = {};
 }
 

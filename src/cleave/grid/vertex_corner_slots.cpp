@@ -2,7 +2,7 @@
 
 namespace cleave {
 
-VertexCornerSlots vertex_corner_slots(const LinkedVolume& volume) {
+VertexCornerSlots vertex_corner_slots(const LinkedVolume& volume, std::int32_t stride) {
   const auto& around = volume.vertex_cells();
   VertexCornerSlots out;
   out.start.assign(around.size() + 1, 0);
@@ -14,7 +14,7 @@ VertexCornerSlots vertex_corner_slots(const LinkedVolume& volume) {
       const auto& corners = volume.cell_vertices(c);
       int a = 0;
       while (corners[static_cast<std::size_t>(a)] != static_cast<VertexId>(v)) ++a;
-      out.slot[static_cast<std::size_t>(out.start[v]) + t] = kCornerCount * static_cast<std::int32_t>(c) + a;
+      out.slot[static_cast<std::size_t>(out.start[v]) + t] = stride * static_cast<std::int32_t>(c) + a;
     }
   return out;
 }

@@ -39,7 +39,7 @@ CentrePointStiffness::CentrePointStiffness(const LinkedVolume& volume, const Ele
     material_[static_cast<std::size_t>(c)] = static_cast<std::uint8_t>(slot);
   }
   any_held_ = std::any_of(held_.begin(), held_.end(), [](std::uint8_t flag) { return flag != 0; });
-  VertexCornerSlots slots = vertex_corner_slots(volume);
+  VertexCornerSlots slots = vertex_corner_slots(volume, 24);  // per_cell_: 24 values per cell
   vertex_start_ = std::move(slots.start);
   vertex_slot_ = std::move(slots.slot);
 }
@@ -117,9 +117,8 @@ void CentrePointStiffness::multiply(const Vector& x_in, Vector& y) const {
     for (VertexId v = r.begin(); v < r.end(); ++v) {
       Vec3 sum = Vec3::Zero();
       for (std::int32_t s = vertex_start_[static_cast<std::size_t>(v)]; s < vertex_start_[static_cast<std::size_t>(v) + 1]; ++s) {
-        const std::int32_t slot = vertex_slot_[static_cast<std::size_t>(s)];
-        const double* cell = per_cell_.data() + 24 * (slot / kCornerCount) + slot % kCornerCount;
-        sum += Vec3(cell[0], cell[8], cell[16]);
+        const double* corner = per_cell_.data() + vertex_slot_[static_cast<std::size_t>(s)];
+        sum += Vec3(corner[0], corner[8], corner[16]);
       }
       const auto i = 3 * static_cast<Eigen::Index>(v);
       if (any_held_)
