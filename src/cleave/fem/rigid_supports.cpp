@@ -211,9 +211,4 @@ void RigidMotionRemover::remove(Vector& u) const {
   }
 }
 
-void remove_rigid_motion(const LinkedVolume& volume, std::span<const int> components, const Vector& weights, Vector& u) {
-  if (components.empty()) return;
-  RigidMotionRemover(volume, components, weights).remove(u);
-}
-
 }  // namespace cleave

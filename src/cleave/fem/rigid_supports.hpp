@@ -4,7 +4,7 @@
 // add_rigid_supports holds the fewest extra dofs (at most 6 per piece, chosen far apart: the
 // classic 3-2-1 support) so that every piece is well posed. For a self-equilibrated load such as
 // T sigma (zero net force and moment on each piece) these supports carry no reaction, so the
-// deformation is exact; remove_rigid_motion then removes the arbitrary rigid part.
+// deformation is exact; RigidMotionRemover then removes the arbitrary rigid part.
 #include <span>
 #include <vector>
 
@@ -21,17 +21,15 @@ struct RigidSupportReport {
 /// Adds zero-displacement supports to `fixed` until each component's rigid motions are held.
 RigidSupportReport add_rigid_supports(const LinkedVolume& volume, FixedDofs& fixed);
 
-/// Subtracts from `u` (3 n_v) the rigid motion of each listed component that best fits it in the
-/// `weights`-weighted least-squares sense (weights per dof, e.g. the lumped mass): afterwards the
-/// piece's weighted mean displacement and mean infinitesimal rotation are zero.
-void remove_rigid_motion(const LinkedVolume& volume, std::span<const int> components, const Vector& weights, Vector& u);
-
-/// remove_rigid_motion for many displacements of one volume (a StaticSolver's solves): the
-/// vertices' pieces, the pieces' frames and their weighted normal equations are set up once, so
-/// that each removal is one pass over the listed pieces' vertices.
+/// Subtracts from displacements `u` (3 n_v) the rigid motion of each listed component that best
+/// fits it in the `weights`-weighted least-squares sense (weights per dof, e.g. the lumped mass):
+/// afterwards the piece's weighted mean displacement and mean infinitesimal rotation are zero.
+/// For many displacements of one volume (a StaticSolver's solves) the vertices' pieces, the
+/// pieces' frames and their weighted normal equations are set up once, so that each removal is
+/// one pass over the listed pieces' vertices.
 ///
 ///   RigidMotionRemover remover(volume, free_components, lumped_mass(model));
-///   remover.remove(u);  // as remove_rigid_motion(volume, free_components, mass, u)
+///   remover.remove(u);
 class RigidMotionRemover {
  public:
   /// The volume must keep its topology and positions while the remover is used. InputError for
