@@ -12,6 +12,7 @@
 #include "cleave/fem/element_table.hpp"
 #include "cleave/fem/residual_stress_forces.hpp"
 #include "cleave/stress/centre_point_stiffness.hpp"
+#include "cleave/stress/equilibrium_operator.hpp"
 #include "cleave/stress/sparse_cholesky.hpp"
 
 namespace cleave {
@@ -50,21 +51,6 @@ constexpr double kDependentDirection = 1e-12;  ///< relative eigenvalue of the s
 
 }  // namespace
 
-namespace {
-
-/// Per dof: 1 where the vertex is held (Gamma_D). InputError for ids out of range.
-std::vector<std::uint8_t> held_dof_flags(const LinkedVolume& volume, std::span<const VertexId> held_vertices) {
-  std::vector<std::uint8_t> held(3 * static_cast<std::size_t>(volume.vertex_count()), 0);
-  for (const VertexId v : held_vertices) {
-    if (v < 0 || v >= volume.vertex_count())
-      throw InputError(fmt::format("held vertex {} does not exist; expected 0 to {}", v, volume.vertex_count() - 1));
-    for (int i = 0; i < 3; ++i) held[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(i)] = 1;
-  }
-  return held;
-}
-
-}  // namespace
-
 struct StressEquilibrator::Impl {
   const TissueModel& model;
   std::vector<std::uint8_t> held_dof;  ///< per dof: 1 = vertex held (Gamma_D)
@@ -85,7 +71,7 @@ struct StressEquilibrator::Impl {
   RecentResults<std::vector<Vec6>, Known> recent{kRememberedDesigns};
 
   Impl(const TissueModel& m, std::span<const VertexId> held_vertices)
-      : model(m), held_dof(held_dof_flags(m.volume, held_vertices)), kc(m.volume, make_element_table(m), held_dof) {}
+      : model(m), held_dof(held_dof_flags(m.volume.vertex_count(), held_vertices)), kc(m.volume, make_element_table(m), held_dof) {}
 
   /// Zeroes the entries of held dofs (their forces are reactions).
   void mask(Vector& forces) const {

@@ -57,14 +57,19 @@ SparseMatrix eigenvalue_divergence_matrix(const LinkedVolume& volume, std::span<
   return g;
 }
 
-void drop_held_vertex_rows(SparseMatrix& t, std::span<const VertexId> held_vertices) {
-  if (held_vertices.empty()) return;
-  std::vector<std::uint8_t> held(static_cast<std::size_t>(t.rows()), 0);
+std::vector<std::uint8_t> held_dof_flags(VertexId vertex_count, std::span<const VertexId> held_vertices) {
+  std::vector<std::uint8_t> held(3 * static_cast<std::size_t>(vertex_count), 0);
   for (const VertexId v : held_vertices) {
-    if (v < 0 || 3 * static_cast<Eigen::Index>(v) + 2 >= t.rows())
-      throw InputError(fmt::format("held vertex {} does not exist; expected 0 to {}", v, t.rows() / 3 - 1));
+    if (v < 0 || v >= vertex_count)
+      throw InputError(fmt::format("held vertex {} does not exist; expected 0 to {}", v, vertex_count - 1));
     for (int a = 0; a < 3; ++a) held[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(a)] = 1;
   }
+  return held;
+}
+
+void drop_held_vertex_rows(SparseMatrix& t, std::span<const VertexId> held_vertices) {
+  if (held_vertices.empty()) return;
+  const std::vector<std::uint8_t> held = held_dof_flags(static_cast<VertexId>(t.rows() / 3), held_vertices);
   t.prune([&](Eigen::Index row, Eigen::Index, double) { return held[static_cast<std::size_t>(row)] == 0; });
 }
 

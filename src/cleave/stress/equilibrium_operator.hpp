@@ -11,6 +11,7 @@
 // singular value (spectral norm), estimated by power iteration on T^T T, so the residual is 1
 // for the worst possible field and 0 for a self-balanced one. "Free vertices" are all vertices:
 // the design is made for the unsupported, uncut body.
+#include <cstdint>
 #include <span>
 #include <vector>
 
@@ -29,6 +30,10 @@ SparseMatrix eigenvalue_divergence_matrix(const LinkedVolume& volume, std::span<
 struct EquilibriumNorm {
   double spectral_norm_mm2 = 0;  ///< estimate of the largest singular value of T
 };
+
+/// Per dof (3 per vertex): 1 where the vertex is held (Gamma_D). InputError "held vertex N does not
+/// exist; ..." for ids out of range.
+std::vector<std::uint8_t> held_dof_flags(VertexId vertex_count, std::span<const VertexId> held_vertices);
 
 /// Zeroes the rows of `held_vertices` (rows 3 v + a) of a matrix with 3 n_v rows, so that the
 /// operator only measures forces at free vertices (paper eq. 2 holds on Gamma_N only).
