@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <type_traits>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -69,12 +70,16 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   single_.rotation.resize(cells);
   twin_.tension.resize(with_tension_ ? cells : 0);
   single_.tension.resize(with_tension_ ? cells : 0);
+  single_.stress_stiffness.resize(with_tension_ ? cells : 0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) {
       single_.rotation[c] = rotations[c].cast<float>();
       if (with_tension_) {
         twin_.tension[c] = c_stress * tension_kPa[c];
         single_.tension[c] = twin_.tension[c].cast<float>();
+        Eigen::Matrix<double, 8, 8> stress = Eigen::Matrix<double, 8, 8>::Zero();
+        for (std::size_t k = 0; k < 6; ++k) stress += twin_.tension[c][static_cast<Eigen::Index>(k)] * twin_.stress_basis[k];
+        single_.stress_stiffness[c] = stress.cast<float>();
       }
     }
   });
@@ -130,7 +135,12 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
         // lazyProduct: unrolled column by column (8 SIMD multiply-adds), not a GEMV call.
         f[static_cast<std::size_t>(i)].noalias() = k[row].lazyProduct(d[0]) + k[row + 1].lazyProduct(d[1]) + k[row + 2].lazyProduct(d[2]);
       }
-      if (with_tension_) {
+      if constexpr (std::is_same_v<Scalar, float>) {
+        if (with_tension_) {
+          const Eigen::Matrix<float, 8, 8>& s = p.stress_stiffness[c];
+          for (std::size_t i = 0; i < 3; ++i) f[i].noalias() += s.lazyProduct(d[i]);
+        }
+      } else if (with_tension_) {
         const Eigen::Matrix<Scalar, 6, 1>& t = p.tension[c];
         if (!t.isZero()) {
           Eigen::Matrix<Scalar, 8, 8> s = t[0] * p.stress_basis[0];

@@ -7,7 +7,10 @@
 // in the cache; R and the tension t per cell); then per vertex, the sum over its cells plus the
 // mass term. It streams the cells' rotations, tension and corners and a 24-value buffer per cell
 // (about 12 MB at 44k cells in float) instead of the assembled blocks (53 MB in float, 106 MB in
-// double), and a step no longer assembles the blocks at all.
+// double), and a step no longer assembles the blocks at all. The float product (the multigrid
+// cycle's, 4 per CG iteration) reads each cell's 8 x 8 stress stiffness, formed once per
+// set_state (256 B per cell, 11 MB at 44k cells): forming it from t at every product was 40 % of
+// the product's time (1.5 -> 0.9 ms at 44k cells, session 19); the double product still forms it.
 //
 //   CorotatedSystemOperator op;
 //   op.set_topology(volume, table);                  // after construction and after every cut
@@ -61,6 +64,10 @@ class CorotatedSystemOperator final : public VertexOperator {
     std::array<Eigen::Matrix<Scalar, 8, 8>, 6> stress_basis;  ///< G_k
     std::vector<Eigen::Matrix<Scalar, 3, 3>> rotation;  ///< per cell (float only; double reads rotations_)
     std::vector<Eigen::Matrix<Scalar, 6, 1>> tension;   ///< per cell: c_stress t
+    /// Per cell: its stress stiffness sum_k (c_stress t_k) G_k, formed once per state (float
+    /// only: the cycle's 4 products per iteration read it instead of forming it from the 6
+    /// tension values each time; the CG's double product still forms it).
+    std::vector<Eigen::Matrix<Scalar, 8, 8>> stress_stiffness;
     Eigen::Matrix<Scalar, Eigen::Dynamic, 1> mass_term;  ///< per dof: c_mass m (0 on fixed dofs)
     mutable Eigen::Matrix<Scalar, Eigen::Dynamic, 1> masked;  ///< x with fixed dofs zeroed
     mutable std::vector<Scalar> per_cell;                     ///< 24 per cell: 8 x, 8 y, 8 z
