@@ -307,6 +307,40 @@ TEST(CorotatedSystemOperator, MultigridRebuildsMidSolveFromTheOperator) {
   EXPECT_LT((x - expected).norm(), 1e-8 * expected.norm());
 }
 
+// CG with its iterations' products in single precision (SolveSettings::single_precision_products,
+// what the multigrid uses for the dynamic step at its loose tolerance): at 1e-6 the solution of
+// the double products; at any tolerance the residual it reports is the true one, in double, and
+// "converged" means that one met the tolerance.
+TEST(CorotatedSystemOperator, CgWithSinglePrecisionProductsReportsTheTrueResidual) {
+  const Fixture f;
+  const CorotatedSystemOperator op = f.op();
+  const SparseMatrix a = f.assembled();
+  BlockJacobi jacobi;
+  jacobi.inverse_blocks = op.inverse_diagonal_blocks();
+  Vector b = probe(a.rows()).reverse();
+  for (std::size_t i = 0; i < f.fixed.size(); ++i)
+    if (f.fixed[i] != 0) b[static_cast<Eigen::Index>(i)] = 0;
+  for (const double tolerance : {1e-6, 1e-13}) {
+    SCOPED_TRACE(fmt::format("tolerance {}", tolerance));
+    SolveSettings settings;
+    settings.relative_tolerance = tolerance;
+    Vector x_double = Vector::Zero(a.rows()), x_single = Vector::Zero(a.rows());
+    const SolveReport in_double = preconditioned_cg(op, b, x_double, jacobi, settings);
+    settings.single_precision_products = true;
+    const SolveReport in_single = preconditioned_cg(op, b, x_single, jacobi, settings);
+    EXPECT_TRUE(in_double.converged);
+    const double true_residual = (b - a * x_single).norm() / b.norm();
+    // Both in double (the operator's product against the assembled CSR): they differ by double
+    // rounding only; a float product would be off by ~1e-7 of ||A x|| / ||b||.
+    EXPECT_NEAR(in_single.relative_residual, true_residual, 0.01 * true_residual + 1e-15);
+    EXPECT_EQ(in_single.converged, true_residual <= tolerance);
+    if (tolerance >= 1e-6) {
+      EXPECT_TRUE(in_single.converged);
+      EXPECT_LT((x_single - x_double).norm(), 1e-5 * x_double.norm());
+    }
+  }
+}
+
 // The step with the operator and the step with the assembled matrix solve the same system: a
 // stressed plate held at one end, cut three times mid-simulation, to a tight tolerance.
 TEST(CorotatedSystemOperator, DynamicsStepsWithItFollowTheAssembledSteps) {

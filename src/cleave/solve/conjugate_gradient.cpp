@@ -15,11 +15,39 @@ constexpr int kMaxRestarts = 2;
 
 enum class CgStop { converged_recurrence, out_of_iterations, breakdown };
 
+/// q = A p of a CG iteration: in double, or (settings.single_precision_products, operators only)
+/// in single precision through the work vectors.
+template <typename Matrix>
+class IterationProduct {
+ public:
+  explicit IterationProduct(const SolveSettings&) {}
+  void operator()(const Matrix& a, const Vector& p, Vector& q) { multiply(a, p, q); }
+};
+
+template <>
+class IterationProduct<VertexOperator> {
+ public:
+  explicit IterationProduct(const SolveSettings& settings) : single_(settings.single_precision_products) {}
+  void operator()(const VertexOperator& a, const Vector& p, Vector& q) {
+    if (!single_) {
+      a.multiply(p, q);
+      return;
+    }
+    p_single_ = p.cast<float>();
+    a.multiply(p_single_, q_single_);
+    q = q_single_.cast<double>();
+  }
+
+ private:
+  bool single_;
+  Eigen::VectorXf p_single_, q_single_;
+};
+
 /// Plain PCG from x; `iterations` is increased by the iterations done. When `initial_norm` is not
 /// null it receives ||b - A x|| of the start (before any iteration).
 template <typename Matrix>
-CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, double& target,
-               double initial_factor, double* initial_norm, int max_iterations, int& iterations) {
+CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, IterationProduct<Matrix>& product,
+               double& target, double initial_factor, double* initial_norm, int max_iterations, int& iterations) {
   const Eigen::Index n = a.rows();
   Vector r(n), z(n), p(n), q(n);
   residual(a, b, x, r);
@@ -32,7 +60,7 @@ CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner
   p = z;
   double rz = r.dot(z);
   while (iterations < max_iterations) {
-    multiply(a, p, q);
+    product(a, p, q);
     const double curvature = p.dot(q);
     if (!(curvature > 0) || !(rz > 0) || !std::isfinite(curvature) || !std::isfinite(rz)) return CgStop::breakdown;
     const double alpha = rz / curvature;
@@ -70,8 +98,9 @@ SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, c
   const Vector start = x;
   Vector r(n);
   double r_norm = 0;
+  IterationProduct<Matrix> product(settings);
   for (int restart = 0; restart <= kMaxRestarts; ++restart) {
-    const CgStop stop = run_pcg(a, b, x, preconditioner, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
+    const CgStop stop = run_pcg(a, b, x, preconditioner, product, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
                                 settings.max_iterations, report.iterations);
     if (!x.allFinite()) x = start;
     residual(a, b, x, r);

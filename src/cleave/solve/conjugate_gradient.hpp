@@ -14,6 +14,9 @@
 // replaced by 0. When the iteration breaks down (non-positive curvature, NaN) or runs out of
 // iterations, x keeps its last finite value (at worst the initial guess) and converged = false:
 // x never holds NaN. Restarts from the true residual when rounding drift fools the recurrence.
+// With settings.single_precision_products (operators only) each iteration's q = A p is a float
+// product; the initial and the final (true) residual stay in double, so the report never rests
+// on the float products.
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/linear_solver.hpp"
 #include "cleave/solve/vertex_operator.hpp"

@@ -35,6 +35,12 @@ struct SolveSettings {
   /// Read by the CG solvers of cleave (multigrid); the peers solve to relative_tolerance.
   double initial_residual_tolerance = 0;
   int max_iterations = 2000;
+  /// CG on an operator applied cell by cell (solve/vertex_operator.hpp): the product of each
+  /// iteration (q = A p) in single precision, half the arithmetic of the double one; the residuals
+  /// that decide convergence (at the start, and the true residual at the end, from which CG
+  /// restarts when the recurrence drifted) stay in double. The multigrid sets it for the dynamic
+  /// step while its cycle runs in single precision. Off: every product in double.
+  bool single_precision_products = false;
   /// cholmod: forward and back substitution with the factor on all cores (SupernodalSubstitution,
   /// cleave's own); false: cholmod_solve as SuiteSparse ships it (the bench's peer).
   bool parallel_substitution = true;
