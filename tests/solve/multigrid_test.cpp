@@ -89,6 +89,32 @@ TEST(GalerkinOperator, EqualsTheExplicitTripleProductAndKeepsRigidTranslations) 
   }
 }
 
+// The Galerkin product from the block CSR copy (what the multigrid solver passes, to skip a second
+// conversion) is the one from the scalar matrix, bit for bit, with fixed dofs; sizes that do not
+// fit the prolongation are refused by name.
+TEST(GalerkinOperator, FromBlocksEqualsFromTheScalarMatrix) {
+  const TissueModel model = test::make_box({6, 5, 4}, 2.0);
+  const SparseMatrix k = assemble_stiffness(model);
+  const Prolongation p = coarsen_grid_level(grid_level_of(model.volume)).prolongation;
+  std::vector<std::uint8_t> fixed(static_cast<std::size_t>(k.rows()), 0);
+  for (std::size_t i = 0; i < fixed.size(); i += 7) fixed[i] = 1;
+  const SparseMatrix from_scalar = galerkin_operator(k, fixed, p);
+  const SparseMatrix from_blocks = galerkin_operator(to_block_sparse<double>(k), fixed, p);
+  ASSERT_EQ(from_blocks.nonZeros(), from_scalar.nonZeros());
+  EXPECT_EQ(Eigen::MatrixXd(from_blocks), Eigen::MatrixXd(from_scalar));
+  const std::vector<std::uint8_t> short_flags(fixed.size() - 3, 0);
+  try {
+    (void)galerkin_operator(to_block_sparse<double>(k), short_flags, p);
+    ADD_FAILURE() << "fixed flags of the wrong size were accepted";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fmt::format("galerkin operator: {} block rows and {} fixed flags for a prolongation from {} fine vertices; expected {} "
+                          "and {}",
+                          model.volume.vertex_count(), short_flags.size(), model.volume.vertex_count(), model.volume.vertex_count(),
+                          fixed.size()));
+  }
+}
+
 /// Component of each vertex of every level, propagated through the prolongations; checks on the
 /// way that no coarse vertex takes values from fine vertices of two different pieces.
 std::vector<std::vector<int>> level_components(const MultigridPreconditioner& m, const LinkedVolume& volume) {

@@ -1,11 +1,13 @@
 #include "cleave/solve/galerkin_operator.hpp"
 
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/enumerable_thread_specific.h>
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
 
+#include "cleave/core/error.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include <utility>
 
@@ -101,11 +103,18 @@ std::vector<std::uint8_t> identity_rows(const SparseMatrix& a) {
 }
 
 SparseMatrix galerkin_operator(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed, const Prolongation& p) {
+  return galerkin_operator(to_block_sparse<double>(a), fixed, p);
+}
+
+SparseMatrix galerkin_operator(const BlockSparseMatrix<double>& blocks, const std::vector<std::uint8_t>& fixed, const Prolongation& p) {
   const auto fine_vertices = static_cast<std::size_t>(p.fine_count());
   const auto coarse_vertices = static_cast<std::size_t>(p.coarse_count());
+  if (blocks.block_rows() != static_cast<Eigen::Index>(fine_vertices) || fixed.size() != 3 * fine_vertices)
+    throw InputError(fmt::format("galerkin operator: {} block rows and {} fixed flags for a prolongation from {} fine vertices; "
+                                 "expected {} and {}",
+                                 blocks.block_rows(), fixed.size(), fine_vertices, fine_vertices, 3 * fine_vertices));
   // A P by fine block rows: (A P)[i, J] = sum_j A[i, j] P[j, J] over free rows and columns,
   // one 3x3 block of A at a time (A as block CSR).
-  const BlockSparseMatrix<double> blocks = to_block_sparse<double>(a);
   BlockRows ap(fine_vertices);
   tbb::enumerable_thread_specific<BlockRowAccumulator> ap_accumulators([&] { return BlockRowAccumulator(coarse_vertices); });
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, fine_vertices, kVerticesPerTask), [&](const tbb::blocked_range<std::size_t>& range) {

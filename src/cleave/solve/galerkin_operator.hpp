@@ -13,12 +13,18 @@
 #include <cstdint>
 #include <vector>
 
+#include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/coarsen_grid_level.hpp"
 #include "cleave/solve/linear_solver.hpp"
 
 namespace cleave {
 
 SparseMatrix galerkin_operator(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed, const Prolongation& prolongation);
+/// The same with `a` given as block CSR (block_sparse_matrix.hpp; the multigrid's fine level has
+/// that copy already: no second one of ~100 MB at 44k cells). InputError when the sizes of `a`,
+/// `fixed` and the prolongation do not fit together.
+SparseMatrix galerkin_operator(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed,
+                               const Prolongation& prolongation);
 
 /// Dofs whose row in `a` is an identity row (no off-diagonal entry other than zero): fixed dofs.
 std::vector<std::uint8_t> identity_rows(const SparseMatrix& a);

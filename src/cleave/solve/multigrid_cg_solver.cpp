@@ -138,7 +138,7 @@ class MultigridCgSolver final : public LinearSolver {
 
  private:
   void build(const LinkedVolume& topology) {
-    preconditioner_ = build_multigrid(a_, topology, options_);
+    preconditioner_ = build_multigrid(a_, topology, options_, &a_blocks_);
     topology_ = &topology;
     stale_updates_ = 0;
     baseline_iterations_ = -1;

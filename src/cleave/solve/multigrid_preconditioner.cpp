@@ -124,11 +124,14 @@ void transpose_prolongation(Prolongation& p) {
 
 }  // namespace
 
-MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options) {
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options,
+                                        const BlockSparseMatrix<double>* a_blocks) {
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (a.rows() != dofs || a.cols() != dofs)
     throw InputError(fmt::format("multigrid: matrix is {} x {}; expected {} x {} (3 dofs per vertex of the linked volume)",
                                  a.rows(), a.cols(), dofs, dofs));
+  if (a_blocks != nullptr && a_blocks->rows() != dofs)
+    throw InputError(fmt::format("multigrid: the block copy of the matrix has {} rows; expected {}", a_blocks->rows(), dofs));
   if (!a.isCompressed()) throw InputError("multigrid: matrix must be compressed (makeCompressed)");
   MultigridPreconditioner m;
   m.fine_ = &a;
@@ -146,7 +149,8 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
     if (ratio > options.min_coarsening_ratio) break;
     MultigridLevel coarse;
-    coarse.matrix = galerkin_operator(current, m.levels_[l].fixed, next.prolongation);
+    coarse.matrix = l == 0 && a_blocks != nullptr ? galerkin_operator(*a_blocks, m.levels_[l].fixed, next.prolongation)
+                                                  : galerkin_operator(current, m.levels_[l].fixed, next.prolongation);
     coarse.fixed = identity_rows(coarse.matrix);
     m.levels_[l].from_coarser = std::move(next.prolongation);
     grid = std::move(next.coarse);

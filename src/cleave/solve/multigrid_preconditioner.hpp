@@ -131,7 +131,7 @@ class MultigridPreconditioner final : public Preconditioner {
 
  private:
   friend MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume,
-                                                 const MultigridOptions& options);
+                                                 const MultigridOptions& options, const BlockSparseMatrix<double>* a_blocks);
   struct CoarsestSolver;
   template <typename Scalar>
   void cycle(std::size_t level) const;
@@ -151,7 +151,10 @@ class MultigridPreconditioner final : public Preconditioner {
   CyclePrecision precision_ = CyclePrecision::single_precision;
 };
 
-MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {});
+/// `a_blocks`: `a` as block CSR when the caller keeps that copy anyway (the multigrid CG solver):
+/// the first Galerkin product then reads it instead of converting `a` once more.
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {},
+                                        const BlockSparseMatrix<double>* a_blocks = nullptr);
 
 /// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
 void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
