@@ -13,13 +13,12 @@ constexpr const char* kUnnamedStage = "computing";  ///< the heartbeat's stage b
 
 }  // namespace
 
-FieldWorker::FieldWorker(Publish publish, PublishProgress progress)
-    : publish_(std::move(publish)),
-      progress_(std::move(progress)),
-      thread_([this] { run(); }),
-      watcher_([this] { watch(); }) {}
+FieldWorker::FieldWorker(Publish publish, PublishProgress progress, JobThread where)
+    : publish_(std::move(publish)), progress_(std::move(progress)), where_(where), watcher_([this] { watch(); }) {
+  if (where_ == JobThread::own) thread_ = std::thread([this] { run(); });
+}
 
-FieldWorker::~FieldWorker() {
+void FieldWorker::stop() {
   {
     std::lock_guard lock(mutex_);
     stopping_ = true;
@@ -27,7 +26,17 @@ FieldWorker::~FieldWorker() {
   }
   latest_.fetch_add(1);  // whatever runs now is superseded
   wake_.notify_all();
-  thread_.join();
+  idle_.notify_all();
+}
+
+void FieldWorker::run_jobs() {
+  if (where_ != JobThread::caller) throw InputError("field worker: run_jobs is for a worker made with JobThread::caller");
+  run();
+}
+
+FieldWorker::~FieldWorker() {
+  stop();
+  if (thread_.joinable()) thread_.join();
   {
     std::lock_guard lock(report_mutex_);
     watcher_stopping_ = true;

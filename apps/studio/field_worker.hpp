@@ -12,6 +12,13 @@
 //
 //   FieldWorker worker([&](FieldWorker::Result r) { broadcast(r.message); });
 //   worker.submit([&](const FieldWorker::Context& ctx) { ...; if (ctx.superseded()) return json{}; ... });
+//
+// The jobs run on a thread of the worker's own, or (JobThread::caller) on the thread that calls
+// run_jobs() until stop(): `cleave studio` runs them on its main thread. glibc serves the main
+// thread from its main heap, which keeps freed blocks for the next job (allocator_tuning.hpp);
+// any other thread gets an arena that maps every block over 64 MB afresh and unmaps it when
+// freed, so each new cut model's matrices and hierarchy (hundreds of MB at 45k cells) page-faulted
+// in again: measured, a cut's first frame came 1.0 s after the cut and its second 1.2 s later.
 #include <atomic>
 #include <chrono>
 #include <condition_variable>
@@ -50,7 +57,12 @@ class FieldWorker {
   /// longest a running job goes without a progress message after that.
   static constexpr double kProgressDelay_s = 0.25;
 
-  explicit FieldWorker(Publish publish, PublishProgress progress = {});
+  /// Where the jobs run (see above).
+  enum class JobThread { own, caller };
+
+  explicit FieldWorker(Publish publish, PublishProgress progress = {}, JobThread where = JobThread::own);
+  /// Stops (the job in flight is superseded) and joins the worker's threads. With
+  /// JobThread::caller, run_jobs() must have returned before.
   ~FieldWorker();
   FieldWorker(const FieldWorker&) = delete;
   FieldWorker& operator=(const FieldWorker&) = delete;
@@ -60,6 +72,11 @@ class FieldWorker {
   std::uint64_t submit(Job job);
   /// Blocks until every submitted job has finished or been dropped (for tests and shutdown).
   void wait_idle();
+  /// JobThread::caller: runs the jobs on this thread until stop(). InputError for a worker with
+  /// its own job thread.
+  void run_jobs();
+  /// Ends run_jobs() after the job in flight, which is superseded (any thread). No job starts after it.
+  void stop();
   /// Jobs actually started so far (superseded queued jobs never start).
   std::uint64_t jobs_started() const { return started_.load(); }
 
@@ -96,7 +113,8 @@ class FieldWorker {
   std::string stage_;
   double fraction_ = 0.0;
 
-  std::thread thread_;
+  JobThread where_;
+  std::thread thread_;  ///< JobThread::own only
   std::thread watcher_;
 };
 

@@ -72,7 +72,7 @@ std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const
 
 }  // namespace
 
-StudioCompute::StudioCompute(const StudioSession& session, std::function<void(std::string)> send)
+StudioCompute::StudioCompute(const StudioSession& session, std::function<void(std::string)> send, FieldWorker::JobThread jobs)
     : session_(session), send_(std::move(send)) {
   std::random_device entropy;
   server_token_ = fmt::format("{:08x}{:08x}", entropy(), entropy());
@@ -105,7 +105,7 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
         }
         send_(std::move(text));
       },
-      [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump()); });
+      [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump()); }, jobs);
 }
 
 StudioCompute::~StudioCompute() { worker_.reset(); }

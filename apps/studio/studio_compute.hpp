@@ -32,7 +32,10 @@ class StudioCompute {
  public:
   /// `send` delivers a message to every client (thread safe; called from the worker thread):
   /// JSON text, or the binary form of wire_message.hpp for results and frames.
-  StudioCompute(const StudioSession& session, std::function<void(std::string)> send);
+  /// `jobs`: where the computations run (FieldWorker::JobThread; `cleave studio`: its main
+  /// thread, through run_jobs()).
+  StudioCompute(const StudioSession& session, std::function<void(std::string)> send,
+                FieldWorker::JobThread jobs = FieldWorker::JobThread::own);
   ~StudioCompute();
 
   /// Starts recomputing for `design` (seq = the session's seq); a newer call supersedes it.
@@ -45,6 +48,9 @@ class StudioCompute {
   void export_result(ExportFormat format, const std::filesystem::path& file) const;
   /// Blocks until the worker is idle (tests).
   void wait_idle() { worker_->wait_idle(); }
+  /// FieldWorker::JobThread::caller: computes on this thread until stop_jobs() (FieldWorker::run_jobs).
+  void run_jobs() { worker_->run_jobs(); }
+  void stop_jobs() { worker_->stop(); }
 
  private:
   nlohmann::json compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx);

@@ -2,7 +2,9 @@
 
 #include <cstdio>
 #include <fmt/format.h>
+#include <exception>
 #include <regex>
+#include <thread>
 
 #include "cleave/core/error.hpp"
 #include "cleave/io/case_file.hpp"
@@ -53,9 +55,14 @@ int run_studio(const StudioMainOptions& options) {
 
   StudioSession session(options.session_folder, options.case_document);
   std::unique_ptr<StudioServer> server;
-  StudioCompute compute(session, [&server](std::string text) {
-    if (server) server->broadcast(std::move(text));
-  });
+  // The computations run on this (the main) thread, the server on a second one: see
+  // FieldWorker::JobThread for why.
+  StudioCompute compute(
+      session,
+      [&server](std::string text) {
+        if (server) server->broadcast(std::move(text));
+      },
+      FieldWorker::JobThread::caller);
   ServerHooks hooks;
   hooks.welcome_messages = [&compute] { return compute.welcome_messages(); };
   hooks.design_changed = [&compute](const StudioSession& s) { compute.design_changed(s.design(), s.seq()); };
@@ -74,7 +81,24 @@ int run_studio(const StudioMainOptions& options) {
               session.torn_bytes_dropped() > 0 ? ", a torn last journal line dropped" : "");
   std::fflush(stdout);
   compute.design_changed(session.design(), session.seq());
-  server->run();
+  std::exception_ptr server_failure;
+  std::thread io([&server, &compute, &server_failure] {
+    try {
+      server->run();  // until SIGINT or SIGTERM
+    } catch (...) {
+      server_failure = std::current_exception();  // rethrown on the main thread, as before
+    }
+    compute.stop_jobs();
+  });
+  try {
+    compute.run_jobs();
+  } catch (...) {
+    server->stop();
+    io.join();
+    throw;
+  }
+  io.join();
+  if (server_failure) std::rethrow_exception(server_failure);
   std::printf("cleave studio: stopped\n");
   return 0;
 }

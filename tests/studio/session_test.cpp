@@ -169,6 +169,62 @@ TEST(FieldWorker, NewerJobsSupersedeOlderOnesAndOnlyCurrentResultsArePublished) 
   EXPECT_EQ(published[0], 9u);
 }
 
+// JobThread::caller (what `cleave studio` uses, so that its jobs allocate from glibc's main heap):
+// the jobs run on the thread that calls run_jobs(), which returns once another thread calls
+// stop(); the job in flight then is superseded and its result dropped. A worker with its own
+// thread refuses run_jobs().
+TEST(FieldWorker, OnTheCallersThreadJobsRunThereUntilStopped) {
+  std::mutex m;
+  std::vector<std::uint64_t> published;
+  FieldWorker worker(
+      [&](FieldWorker::Result r) {
+        std::lock_guard lock(m);
+        published.push_back(r.generation);
+      },
+      {}, FieldWorker::JobThread::caller);
+  const std::thread::id caller = std::this_thread::get_id();
+  std::atomic<int> on_caller{0}, elsewhere{0};
+  std::atomic<bool> second_started{false};
+  worker.submit([&](const FieldWorker::Context& ctx) {
+    (std::this_thread::get_id() == caller ? on_caller : elsewhere).fetch_add(1);
+    return json{{"type", "result"}, {"g", ctx.generation}};
+  });
+  std::thread stopper([&] {
+    // The first job's result, then a second job that runs until stop() supersedes it.
+    for (;;) {
+      {
+        std::lock_guard lock(m);
+        if (!published.empty()) break;
+      }
+      std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    }
+    worker.submit([&](const FieldWorker::Context& ctx) {
+      (std::this_thread::get_id() == caller ? on_caller : elsewhere).fetch_add(1);
+      second_started = true;
+      while (!ctx.superseded()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+      return json{{"type", "result"}, {"g", ctx.generation}};
+    });
+    while (!second_started.load()) std::this_thread::sleep_for(std::chrono::milliseconds(1));
+    worker.stop();
+  });
+  worker.run_jobs();  // returns after stop()
+  stopper.join();
+  EXPECT_EQ(on_caller.load(), 2);
+  EXPECT_EQ(elsewhere.load(), 0);
+  ASSERT_EQ(published.size(), 1u) << "the job that stop() superseded publishes nothing";
+  EXPECT_EQ(published[0], 1u);
+  worker.submit([](const FieldWorker::Context&) { return json{{"type", "result"}}; });
+  EXPECT_EQ(worker.jobs_started(), 2u) << "no job starts after stop()";
+
+  FieldWorker own([](FieldWorker::Result) {});
+  try {
+    own.run_jobs();
+    ADD_FAILURE() << "run_jobs on a worker with its own thread";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), "field worker: run_jobs is for a worker made with JobThread::caller");
+  }
+}
+
 /// Every message a worker sends, in order: progress (stage or "result").
 struct SentMessages {
   std::mutex m;
