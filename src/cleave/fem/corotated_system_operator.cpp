@@ -18,6 +18,15 @@ namespace {
 constexpr CellId kCellsPerTask = 512;
 constexpr VertexId kVerticesPerTask = 1024;
 
+/// A cell's stress stiffness sum_k t_k G_k (8 x 8, the coefficient of I_3 per corner pair).
+template <typename Scalar>
+Eigen::Matrix<Scalar, 8, 8> stress_stiffness_of(const Eigen::Matrix<Scalar, 6, 1>& t,
+                                                const std::array<Eigen::Matrix<Scalar, 8, 8>, 6>& basis) {
+  Eigen::Matrix<Scalar, 8, 8> s = t[0] * basis[0];
+  for (int q = 1; q < 6; ++q) s += t[q] * basis[static_cast<std::size_t>(q)];
+  return s;
+}
+
 }  // namespace
 
 void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const ElementTable& table) {
@@ -77,9 +86,7 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
       if (with_tension_) {
         twin_.tension[c] = c_stress * tension_kPa[c];
         single_.tension[c] = twin_.tension[c].cast<float>();
-        Eigen::Matrix<double, 8, 8> stress = Eigen::Matrix<double, 8, 8>::Zero();
-        for (std::size_t k = 0; k < 6; ++k) stress += twin_.tension[c][static_cast<Eigen::Index>(k)] * twin_.stress_basis[k];
-        single_.stress_stiffness[c] = stress.cast<float>();
+        single_.stress_stiffness[c] = stress_stiffness_of(twin_.tension[c], twin_.stress_basis).cast<float>();
       }
     }
   });
@@ -143,8 +150,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       } else if (with_tension_) {
         const Eigen::Matrix<Scalar, 6, 1>& t = p.tension[c];
         if (!t.isZero()) {
-          Eigen::Matrix<Scalar, 8, 8> s = t[0] * p.stress_basis[0];
-          for (int q = 1; q < 6; ++q) s += t[q] * p.stress_basis[static_cast<std::size_t>(q)];
+          const Eigen::Matrix<Scalar, 8, 8> s = stress_stiffness_of(t, p.stress_basis);
           for (std::size_t i = 0; i < 3; ++i) f[i].noalias() += s.lazyProduct(d[i]);
         }
       }
