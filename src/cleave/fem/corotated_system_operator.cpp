@@ -7,6 +7,7 @@
 #include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
 #include "cleave/grid/vertex_corner_slots.hpp"
@@ -28,6 +29,15 @@ Eigen::Matrix<Scalar, 8, 8> stress_stiffness_of(const Eigen::Matrix<Scalar, 6, 1
 }
 
 }  // namespace
+
+bool avx512_cell_pass_supported() {
+#if defined(__x86_64__) && (defined(__GNUC__) || defined(__clang__))
+  static const bool supported = kAvx512CellPassCompiled && __builtin_cpu_supports("avx512f") && __builtin_cpu_supports("avx512dq");
+  return supported;
+#else
+  return false;
+#endif
+}
 
 void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const ElementTable& table) {
   volume_ = &volume;
@@ -121,6 +131,24 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
   }
   const std::size_t cells = material_.size();
   p.per_cell.resize(24 * cells);
+  if constexpr (std::is_same_v<Scalar, float>) {
+    if (wide_cell_pass_ && cells > 0) {
+      static_assert(sizeof(CornerBlocks<float>) == 9 * 64 * sizeof(float) && sizeof(Eigen::Matrix3f) == 9 * sizeof(float) &&
+                    sizeof(Eigen::Matrix<float, 8, 8>) == 64 * sizeof(float) && sizeof(std::array<VertexId, 8>) == 8 * sizeof(std::int32_t));
+      CorotatedCellsInput in;
+      in.x = x->data();
+      in.corners = volume_->cell_vertices(0).data();
+      in.rotation = p.rotation.front().data();
+      in.material = material_.data();
+      in.stiffness = p.stiffness_by_component.front().front().data();
+      in.stress_stiffness = with_tension_ ? p.stress_stiffness.front().data() : nullptr;
+      in.per_cell = p.per_cell.data();
+      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
+                        [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
+      sum_per_vertex(p, x_in, *x, y);
+      return;
+    }
+  }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) {
       const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
@@ -160,6 +188,14 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
         Eigen::Map<Corners<Scalar>>(out + 8 * i) = rotation(i, 0) * f[0] + rotation(i, 1) * f[1] + rotation(i, 2) * f[2];
     }
   });
+  sum_per_vertex(p, x_in, *x, y);
+}
+
+template <typename Scalar>
+void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
+                                             const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked,
+                                             Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const {
+  const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>* x = &x_masked;
   y.resize(x_in.size());
   const auto vertices = static_cast<VertexId>(vertex_start_.size() - 1);
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<VertexId>& r) {
@@ -179,6 +215,12 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
 }
 
 void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const { apply(single_, x, y); }
+
+void CorotatedSystemOperator::set_wide_cell_pass(bool on) {
+  if (on && !avx512_cell_pass_supported())
+    throw InputError("corotated system: the AVX-512 cell pass needs a CPU with AVX-512 F and DQ; this one has not");
+  wide_cell_pass_ = on;
+}
 void CorotatedSystemOperator::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const { apply(twin_, x, y); }
 
 double CorotatedSystemOperator::stress_coefficient(std::size_t cell, int a, int b) const {

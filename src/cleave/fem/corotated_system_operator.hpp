@@ -11,6 +11,8 @@
 // cycle's, 4 per CG iteration) reads each cell's 8 x 8 stress stiffness, formed once per
 // set_state (256 B per cell, 11 MB at 44k cells): forming it from t at every product was 40 % of
 // the product's time (1.5 -> 0.9 ms at 44k cells, session 19); the double product still forms it.
+// Where the CPU has AVX-512, the float cell pass takes two cells per 16-float register
+// (fem/corotated_cells_avx512.hpp; 0.83-0.87 of the portable pass's product at 44k cells).
 //
 //   CorotatedSystemOperator op;
 //   op.set_topology(volume, table);                  // after construction and after every cut
@@ -24,6 +26,7 @@
 #include <span>
 #include <vector>
 
+#include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/grid/linked_volume.hpp"
 #include "cleave/solve/vertex_operator.hpp"
@@ -48,6 +51,12 @@ class CorotatedSystemOperator final : public VertexOperator {
   std::vector<Mat3> inverse_diagonal_blocks() const override;
   SparseMatrix assembled_matrix() const override;
   const std::vector<std::uint8_t>& fixed_dofs() const override { return *fixed_; }
+
+  /// The float product's cell pass in AVX-512, two cells per register
+  /// (fem/corotated_cells_avx512.hpp): on by default where the CPU has it. Throws InputError when
+  /// asked for on a CPU without it. Off: the portable pass (one cell per 8-float register).
+  void set_wide_cell_pass(bool on);
+  bool wide_cell_pass() const { return wide_cell_pass_; }
 
  private:
   /// Cell values by component: for component i (x, y, z), the 8 corners' values (a SIMD register
@@ -75,6 +84,11 @@ class CorotatedSystemOperator final : public VertexOperator {
   template <typename Scalar>
   void apply(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const;
+  /// y = the per-cell values summed per vertex plus the mass term (x_masked: x with fixed dofs
+  /// zero), identity rows for fixed dofs.
+  template <typename Scalar>
+  void sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
+                      const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const;
   template <typename Scalar>
   const Eigen::Matrix<Scalar, 3, 3>& rotation_of(const Precision<Scalar>& p, std::size_t cell) const;
   /// The coefficient of I_3 in block (a, b) of cell c's stress stiffness, times c_stress.
@@ -91,6 +105,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   const std::vector<std::uint8_t>* fixed_ = nullptr;
   double c_mass_ = 0;  ///< c_stiff and c_stress are folded into stiffness and tension
   const Vector* mass_kg_ = nullptr;
+  bool wide_cell_pass_ = avx512_cell_pass_supported();
   Precision<float> single_;
   Precision<double> twin_;
 };
