@@ -157,14 +157,18 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     m.levels_.push_back(std::move(coarse));
   }
   m.precision_ = options.precision;
+  if (options.coarse_degree < 1)
+    throw InputError(fmt::format("multigrid: coarse smoother degree is {}; expected 1 or more", options.coarse_degree));
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     MultigridLevel& level = m.levels_[l];
+    ChebyshevOptions smoother = options.smoother;
+    if (l > 0) smoother.degree = options.coarse_degree;
     if (m.precision_ == CyclePrecision::single_precision) {
       level.single.blocks = to_block_sparse<float>(m.operator_of(l));
-      level.smoother = make_chebyshev_smoother(level.single.blocks, options.smoother);
+      level.smoother = make_chebyshev_smoother(level.single.blocks, smoother);
     } else {
       level.twin.blocks = to_block_sparse<double>(m.operator_of(l));
-      level.smoother = make_chebyshev_smoother(level.twin.blocks, options.smoother);
+      level.smoother = make_chebyshev_smoother(level.twin.blocks, smoother);
     }
   }
 
