@@ -18,6 +18,7 @@ namespace {
 
 constexpr CellId kCellsPerTask = 512;
 constexpr VertexId kVerticesPerTask = 1024;
+constexpr Eigen::Index kDofsPerTask = Eigen::Index{1} << 14;
 
 /// A cell's stress stiffness sum_k t_k G_k (8 x 8, the coefficient of I_3 per corner pair).
 template <typename Scalar>
@@ -64,7 +65,13 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   rotations_ = rotations;
   with_tension_ = !tension_kPa.empty();
   fixed_ = &fixed;
-  any_fixed_ = std::any_of(fixed.begin(), fixed.end(), [](std::uint8_t f) { return f != 0; });
+  if (fixed != fixed_seen_) {  // a step keeps its fixed dofs: listed once
+    fixed_seen_ = fixed;
+    fixed_rows_.clear();
+    for (std::size_t i = 0; i < dofs; ++i)
+      if (fixed[i] != 0) fixed_rows_.push_back(static_cast<Eigen::Index>(i));
+  }
+  any_fixed_ = !fixed_rows_.empty();
   c_mass_ = c_mass;
   mass_kg_ = &mass_kg;
   const std::size_t materials = table_->per_material.size();
@@ -124,9 +131,11 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
     throw InputError(fmt::format("corotated system: vector has {} entries; expected {}", x_in.size(), rows()));
   const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>* x = &x_in;
   if (any_fixed_) {  // fixed columns are zero
-    p.masked = x_in;
-    for (std::size_t i = 0; i < fixed_->size(); ++i)
-      if ((*fixed_)[i] != 0) p.masked[static_cast<Eigen::Index>(i)] = 0;
+    p.masked.resize(x_in.size());
+    tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, x_in.size(), kDofsPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+      p.masked.segment(r.begin(), r.end() - r.begin()) = x_in.segment(r.begin(), r.end() - r.begin());
+    });
+    for (const Eigen::Index i : fixed_rows_) p.masked[i] = 0;
     x = &p.masked;
   }
   const std::size_t cells = material_.size();
@@ -206,12 +215,10 @@ void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const E
         const Scalar* slot = p.per_cell.data() + vertex_slot_[static_cast<std::size_t>(s)];
         sum += Eigen::Matrix<Scalar, 3, 1>(slot[0], slot[8], slot[16]);
       }
-      if (any_fixed_)
-        for (int axis = 0; axis < 3; ++axis)
-          if ((*fixed_)[static_cast<std::size_t>(i + axis)] != 0) sum[axis] = x_in[i + axis];  // identity row
       y.template segment<3>(i) = sum;
     }
   });
+  for (const Eigen::Index i : fixed_rows_) y[i] = x_in[i];  // identity rows
 }
 
 void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const { apply(single_, x, y); }

@@ -103,6 +103,8 @@ class CorotatedSystemOperator final : public VertexOperator {
   bool with_tension_ = false;
   bool any_fixed_ = false;
   const std::vector<std::uint8_t>* fixed_ = nullptr;
+  std::vector<Eigen::Index> fixed_rows_;   ///< the fixed dofs, listed
+  std::vector<std::uint8_t> fixed_seen_;   ///< the flags fixed_rows_ lists (set_state compares)
   double c_mass_ = 0;  ///< c_stiff and c_stress are folded into stiffness and tension
   const Vector* mass_kg_ = nullptr;
   bool wide_cell_pass_ = avx512_cell_pass_supported();

@@ -118,7 +118,9 @@ Mat24 hex8_consistent_mass(double h_mm, double density_kg_per_mm3) {
 }
 
 Mat3 hex8_center_deformation_gradient(const Vec24& u, double h_mm) {
-  const Eigen::Matrix<double, 8, 3> g = shape_gradients_local(Vec3::Constant(0.5)) / h_mm;
+  // Every step takes it for every cell: the centre's local gradients (+-1/4) are formed once.
+  static const Eigen::Matrix<double, 8, 3> centre = shape_gradients_local(Vec3::Constant(0.5));
+  const Eigen::Matrix<double, 8, 3> g = centre / h_mm;
   Mat3 f = Mat3::Identity();
   for (int a = 0; a < 8; ++a) f += u.segment<3>(3 * a) * g.row(a);
   return f;
