@@ -169,6 +169,35 @@ TEST(SolverAgreement, SingleAndDoublePrecisionCyclesAgree) {
   EXPECT_LE(iterations[0], iterations[1] + 3);
 }
 
+// A solve that needs more than one round of the float cycle (40 iterations) but keeps cutting the
+// residual goes on in single precision: the double cycle (twice the bytes per iteration, and a
+// double copy of every level) is for float rounding that stalls a round.
+TEST(SolverAgreement, ASlowButSteadyFloatCycleStaysInSinglePrecision) {
+  // A slender cantilever and the lightest smoothing: 56 iterations to 1e-10.
+  const TissueModel model = test::make_box({32, 8, 4}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  MultigridOptions options;
+  options.coarsest_max_dofs = 30;
+  options.smoother.degree = 1;
+  options.coarse_degree = 1;
+  auto solver = make_multigrid_cg_solver(tight(), options);
+  solver->setup(s.a, model.volume);
+  Vector x = Vector::Zero(s.b.size());
+  const SolveReport r = solver->solve(s.b, x);
+  std::printf("slender cantilever: %d iterations, %d of them with the double cycle\n", r.iterations, r.double_cycle_iterations);
+  EXPECT_TRUE(r.converged);
+  EXPECT_GT(r.iterations, 40);
+  EXPECT_EQ(r.double_cycle_iterations, 0);
+  options.precision = CyclePrecision::double_precision;  // built in double: every iteration counts
+  auto twin = make_multigrid_cg_solver(tight(), options);
+  twin->setup(s.a, model.volume);
+  Vector y = Vector::Zero(s.b.size());
+  const SolveReport d = twin->solve(s.b, y);
+  EXPECT_TRUE(d.converged);
+  EXPECT_EQ(d.double_cycle_iterations, d.iterations);
+  EXPECT_LT((x - y).norm() / y.norm(), kAgreement);
+}
+
 }  // namespace
 }  // namespace cleave
 

@@ -204,13 +204,12 @@ template <typename Scalar>
 void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
                                              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked,
                                              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const {
-  const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>* x = &x_masked;
   y.resize(x_in.size());
   const auto vertices = static_cast<VertexId>(vertex_start_.size() - 1);
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<VertexId>& r) {
     for (VertexId v = r.begin(); v < r.end(); ++v) {
       const auto i = 3 * static_cast<Eigen::Index>(v);
-      Eigen::Matrix<Scalar, 3, 1> sum = p.mass_term.template segment<3>(i).cwiseProduct(x->template segment<3>(i));
+      Eigen::Matrix<Scalar, 3, 1> sum = p.mass_term.template segment<3>(i).cwiseProduct(x_masked.template segment<3>(i));
       for (std::int32_t s = vertex_start_[static_cast<std::size_t>(v)]; s < vertex_start_[static_cast<std::size_t>(v) + 1]; ++s) {
         const Scalar* slot = p.per_cell.data() + vertex_slot_[static_cast<std::size_t>(s)];
         sum += Eigen::Matrix<Scalar, 3, 1>(slot[0], slot[8], slot[16]);

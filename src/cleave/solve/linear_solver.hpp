@@ -51,6 +51,9 @@ struct SolveReport {
   double relative_residual = 0;  ///< ||b - A x|| / ||b|| reached
   double initial_relative_residual = 0;  ///< ||b - A x0|| / ||b|| of the initial guess (CG solvers; 0 otherwise)
   bool converged = false;  ///< relative_residual <= relative_tolerance, or the initial_residual_tolerance rule met
+  /// Multigrid: of the iterations, those with the double-precision cycle (after float rounding
+  /// stalled the single-precision one, or when it was built so).
+  int double_cycle_iterations = 0;
 };
 
 class LinearSolver {
