@@ -39,11 +39,13 @@ struct MultigridOptions {
   ChebyshevOptions smoother;
   /// The Chebyshev degree on the coarse levels (the fine level's is smoother.degree). The coarse
   /// correction's accuracy bounds the iterations: on the 44k tube's dynamic step 12.5 / 10.2 /
-  /// 8.8 / 8.7 / 8.9 CG iterations at coarse degree 1 / 2 / 3 / 4 / 10, where a coarse pass costs
-  /// a seventh of a fine one. 3 took 0.94 of the time per step of 2.
+  /// 8.8 / 8.7 / 8.9 CG iterations at coarse degree 1 / 2 / 3 / 4 / 10. A level-1 pass reads a
+  /// seventh of a fine product's bytes, but with its vector work degree 3 costs about what it
+  /// saves on the bench's step (equal times), 0.94x in the step harness; the preview needs fewer
+  /// iterations (62 -> 51 on the 350k-cell tube).
   int coarse_degree = 3;
-  /// The cycle's precision at build; multigrid_cg_solver falls back to double when CG with the
-  /// single-precision cycle does not converge.
+  /// The cycle's precision at build; multigrid_cg_solver falls back to double when float rounding
+  /// stalls CG with the single-precision cycle.
   CyclePrecision precision = CyclePrecision::single_precision;
   /// update_values() keeps the coarse levels of an older matrix for at most this many updates
   /// (only the fine level's matrix and block diagonal follow every update) ... A rebuild costs
