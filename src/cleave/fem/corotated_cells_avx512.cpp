@@ -11,9 +11,9 @@ const bool kAvx512CellPassCompiled = true;
 
 namespace {
 
-/// Lane b of each half spread over that half: [v[b] x 8, v[8 + b] x 8].
-__m512i spread_index(int b) {
-  return _mm512_inserti64x4(_mm512_castsi256_si512(_mm256_set1_epi32(b)), _mm256_set1_epi32(8 + b), 1);
+/// A permute index that fills the lower half with lane `lower` and the upper with lane `upper`.
+__m512i halves(int lower, int upper) {
+  return _mm512_inserti64x4(_mm512_castsi256_si512(_mm256_set1_epi32(lower)), _mm256_set1_epi32(upper), 1);
 }
 
 /// Two 8-float columns side by side: [first, second].
@@ -43,8 +43,7 @@ void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
     const __m512 upper = _mm512_maskz_loadu_ps(single ? 0x0 : 0x3, in.rotation + 9 * c + 16);
     for (int k = 0; k < 9; ++k) {
       const int second = single ? k : 9 + k;  // lane of R_d(k) in [lower, upper]
-      const __m512i index = _mm512_inserti64x4(_mm512_castsi256_si512(_mm256_set1_epi32(k)), _mm256_set1_epi32(second), 1);
-      rotation[k] = _mm512_permutex2var_ps(lower, index, upper);
+      rotation[k] = _mm512_permutex2var_ps(lower, halves(k, second), upper);
     }
   }
   // Into the cells' frames: d_i = sum_j R_ji x_j.
@@ -62,7 +61,7 @@ void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
   const float* s_d = in.stress_stiffness != nullptr ? in.stress_stiffness + 64 * d : nullptr;
   __m512 f[3] = {_mm512_setzero_ps(), _mm512_setzero_ps(), _mm512_setzero_ps()};
   for (int b = 0; b < 8; ++b) {
-    const __m512i spread = spread_index(b);
+    const __m512i spread = halves(b, 8 + b);  // corner b of each cell over its half
     __m512 value[3];
     for (int j = 0; j < 3; ++j) value[j] = _mm512_permutexvar_ps(spread, local[j]);
     for (int i = 0; i < 3; ++i)

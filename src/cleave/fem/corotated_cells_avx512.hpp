@@ -34,7 +34,7 @@ extern const bool kAvx512CellPassCompiled;
 /// The kernel was compiled and the CPU runs AVX-512 F and DQ (checked once).
 bool avx512_cell_pass_supported();
 
-/// per_cell of cells [begin, end): R [K f + s (x) I_3] R^T x_e, as the portable pass computes it.
+/// per_cell of cells [begin, end): R [K + s (x) I_3] R^T x_e, as the portable pass computes it.
 void corotated_cells_avx512(const CorotatedCellsInput& in, std::size_t begin, std::size_t end);
 
 }  // namespace cleave

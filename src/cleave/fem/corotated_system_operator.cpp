@@ -71,7 +71,6 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
     for (std::size_t i = 0; i < dofs; ++i)
       if (fixed[i] != 0) fixed_rows_.push_back(static_cast<Eigen::Index>(i));
   }
-  any_fixed_ = !fixed_rows_.empty();
   c_mass_ = c_mass;
   mass_kg_ = &mass_kg;
   const std::size_t materials = table_->per_material.size();
@@ -130,7 +129,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
   if (x_in.size() != rows())
     throw InputError(fmt::format("corotated system: vector has {} entries; expected {}", x_in.size(), rows()));
   const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>* x = &x_in;
-  if (any_fixed_) {  // fixed columns are zero
+  if (!fixed_rows_.empty()) {  // fixed columns are zero
     p.masked.resize(x_in.size());
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, x_in.size(), kDofsPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
       p.masked.segment(r.begin(), r.end() - r.begin()) = x_in.segment(r.begin(), r.end() - r.begin());
@@ -253,7 +252,7 @@ std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
                         }
                         const auto i = 3 * static_cast<Eigen::Index>(v);
                         block.diagonal() += twin_.mass_term.segment<3>(i);
-                        if (any_fixed_)
+                        if (!fixed_rows_.empty())
                           for (int axis = 0; axis < 3; ++axis)
                             if ((*fixed_)[static_cast<std::size_t>(i + axis)] != 0) {
                               block.row(axis).setZero();
@@ -281,7 +280,7 @@ SparseMatrix CorotatedSystemOperator::assembled_matrix() const {
     for (VertexId v = r.begin(); v != r.end(); ++v) gather_vertex_rows(*volume_, v, block, a);
   });
   for (Eigen::Index i = 0; i < a.rows(); ++i) a.coeffRef(i, i) += c_mass_ * (*mass_kg_)[i];
-  if (any_fixed_) {
+  if (!fixed_rows_.empty()) {
     FixedDofs held;
     held.fixed = *fixed_;
     held.value_mm = Vector::Zero(rows());

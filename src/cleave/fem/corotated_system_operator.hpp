@@ -101,9 +101,8 @@ class CorotatedSystemOperator final : public VertexOperator {
   std::vector<std::int32_t> vertex_slot_;      ///< per slot: 24 c + a (cell c, corner a): its x in per_cell
   std::span<const Mat3> rotations_;
   bool with_tension_ = false;
-  bool any_fixed_ = false;
   const std::vector<std::uint8_t>* fixed_ = nullptr;
-  std::vector<Eigen::Index> fixed_rows_;   ///< the fixed dofs, listed
+  std::vector<Eigen::Index> fixed_rows_;   ///< the fixed dofs, listed (empty: none held)
   std::vector<std::uint8_t> fixed_seen_;   ///< the flags fixed_rows_ lists (set_state compares)
   double c_mass_ = 0;  ///< c_stiff and c_stress are folded into stiffness and tension
   const Vector* mass_kg_ = nullptr;

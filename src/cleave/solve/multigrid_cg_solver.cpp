@@ -204,14 +204,13 @@ class MultigridCgSolver final : public LinearSolver {
       single.relative_residual = round.relative_residual;
       single.converged = round.converged;
     }
-    const double initial = single.initial_relative_residual;
     if (single.converged || single.iterations >= settings.max_iterations) return single;
     // Float rounding of an ill-conditioned A: go on from x in double, within the budget.
     preconditioner_.use_double_precision(a_blocks_);
     SolveReport report = cg(b, x, continuation(settings, single, settings.max_iterations - single.iterations));
     report.double_cycle_iterations = report.iterations;
     report.iterations += single.iterations;
-    report.initial_relative_residual = initial;
+    report.initial_relative_residual = single.initial_relative_residual;
     return report;
   }
 
