@@ -69,7 +69,8 @@ IncisedPreview incised_preview(const TissueModel& uncut, const BenchScenario& sc
     apply_cut_plan(p.model.volume, plan);
     p.held = vertices_only_of(p.model.volume, plan.hidden_cells());
   }
-  p.stiffness = assemble_stiffness(p.model);
+  SparseMatrix stiffness = assemble_stiffness(p.model);
+  p.stiffness.swap(stiffness);  // Eigen 3.4's SparseMatrix has no move assignment
   p.surface = build_render_surface(p.model);
   return p;
 }

@@ -401,7 +401,10 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     f["cross_kPa"] = packed_floats(cross);
   }
   if (has_stress) {
-    if (divergence_.size() == 0) divergence_ = stress_divergence_matrix(model.volume);
+    if (divergence_.size() == 0) {
+      SparseMatrix divergence = stress_divergence_matrix(model.volume);
+      divergence_.swap(divergence);
+    }
     // An edit back to a recent design gives the same stress on the same surface: the same values.
     if (const std::vector<float>* known = surface_residuals_.find(stress_kPa_)) {
       f["residual_kPa"] = packed_floats(*known);

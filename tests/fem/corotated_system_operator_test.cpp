@@ -293,7 +293,7 @@ TEST(CorotatedSystemOperator, MultigridCycleOnTheOperatorIsTheCycleOnTheBlocks) 
                              cut_state.rotations, cut_state.tension);
   const SparseMatrix a_cut = cut_state.assembled();
   const CorotatedSystemOperator op_cut = cut_state.op();
-  on_blocks.replace_fine_level(a_cut, to_block_sparse<double>(a_cut), origins, options.smoother);
+  on_blocks.replace_fine_level(to_block_sparse<double>(a_cut), origins, options.smoother);
   on_operator.replace_fine_level(op_cut, op_cut.inverse_diagonal_blocks(), origins, options.smoother);
   EXPECT_EQ(on_operator.levels()[0].fixed, cut_state.fixed);
   EXPECT_NEAR(on_operator.levels()[0].smoother.lambda_max, on_blocks.levels()[0].smoother.lambda_max,

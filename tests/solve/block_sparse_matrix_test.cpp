@@ -100,5 +100,17 @@ TEST(BlockSparseMatrix, MixedBlockRowsGiveTheSameOperator) {
   expect_same_operator(mixed);
 }
 
+// Back to scalar CSR: the same matrix, entry for entry, with the blocks' zeros stored (scattered
+// entries leave most of each block empty).
+TEST(BlockSparseMatrix, ScalarCopyOfTheBlocksIsTheMatrix) {
+  for (const SparseMatrix& a : {vertex_block_matrix(4, 5), scattered_matrix(3, 6)}) {
+    const BlockSparseMatrix<double> b = to_block_sparse<double>(a);
+    const SparseMatrix back = to_scalar_sparse(b);
+    EXPECT_TRUE(back.isCompressed());
+    EXPECT_EQ(back.nonZeros(), static_cast<Eigen::Index>(b.values.size()));
+    EXPECT_EQ(Eigen::MatrixXd(back), Eigen::MatrixXd(a));
+  }
+}
+
 }  // namespace
 }  // namespace cleave

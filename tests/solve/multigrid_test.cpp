@@ -115,6 +115,55 @@ TEST(GalerkinOperator, FromBlocksEqualsFromTheScalarMatrix) {
   }
 }
 
+// The fixed dofs read off the block copy are those read off the scalar matrix: rows eliminated
+// to identity, and no others (a row whose only off-diagonal entries are zero counts; one with a
+// zero diagonal does not).
+TEST(GalerkinOperator, IdentityRowsOfTheBlocksAreThoseOfTheScalarMatrix) {
+  const TissueModel model = test::make_box({6, 5, 4}, 2.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  const std::vector<std::uint8_t> from_scalar = identity_rows(s.a);
+  const auto held = static_cast<std::size_t>(std::count(from_scalar.begin(), from_scalar.end(), std::uint8_t{1}));
+  EXPECT_EQ(held, 3u * 5u * 6u);  // the 6 x 5 vertices of the plane x = 0, three dofs each
+  EXPECT_EQ(identity_rows(to_block_sparse<double>(s.a)), from_scalar);
+  SparseMatrix zero_diagonal = s.a;
+  for (Eigen::Index row = 0; row < zero_diagonal.rows(); ++row)
+    if (from_scalar[static_cast<std::size_t>(row)] != 0) {
+      zero_diagonal.coeffRef(row, row) = 0.0;
+      break;
+    }
+  const std::vector<std::uint8_t> fewer = identity_rows(to_block_sparse<double>(zero_diagonal));
+  EXPECT_EQ(static_cast<std::size_t>(std::count(fewer.begin(), fewer.end(), std::uint8_t{1})), held - 1);
+  EXPECT_EQ(fewer, identity_rows(zero_diagonal));
+}
+
+// The hierarchy keeps no reference to the matrix it was built from: one built from a temporary
+// (scalar or block CSR) applies the same cycle as one built from a matrix that lives on (under
+// ASan a kept reference reads freed memory). Level 0 has no scalar operator to hand out.
+TEST(Multigrid, TheHierarchyOwnsItsOperators) {
+  const TissueModel model = test::make_box({16, 8, 4}, 2.5);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  MultigridOptions options;
+  options.coarsest_max_dofs = 100;
+  const MultigridPreconditioner kept = build_multigrid(s.a, model.volume, options);
+  const MultigridPreconditioner from_temporary = build_multigrid(SparseMatrix(s.a), model.volume, options);
+  const MultigridPreconditioner from_blocks = build_multigrid(to_block_sparse<double>(s.a), model.volume, options);
+  ASSERT_GE(kept.levels().size(), 3u);
+  Vector z_kept, z_temporary, z_blocks;
+  kept.apply(s.b, z_kept);
+  from_temporary.apply(s.b, z_temporary);
+  from_blocks.apply(s.b, z_blocks);
+  EXPECT_GT(z_kept.norm(), 0.0);
+  EXPECT_EQ(z_temporary, z_kept);
+  EXPECT_EQ(z_blocks, z_kept);
+  EXPECT_EQ(kept.coarse_operator(1).rows(), 3 * static_cast<Eigen::Index>(kept.levels()[1].smoother.inverse_diagonal.size()));
+  try {
+    (void)kept.coarse_operator(0);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("multigrid: level 0 has no coarse operator; expected 1 to {}", kept.levels().size() - 1));
+  }
+}
+
 /// Component of each vertex of every level, propagated through the prolongations; checks on the
 /// way that no coarse vertex takes values from fine vertices of two different pieces.
 std::vector<std::vector<int>> level_components(const MultigridPreconditioner& m, const LinkedVolume& volume) {
@@ -148,7 +197,7 @@ TEST(Multigrid, CoarseLevelsDoNotCoupleThePiecesOfAFullCut) {
   ASSERT_GE(m.levels().size(), 4u);
   const auto components = level_components(m, model.volume);
   for (std::size_t l = 1; l < m.levels().size(); ++l) {
-    const SparseMatrix& a = m.operator_of(l);
+    const SparseMatrix& a = m.coarse_operator(l);
     std::map<int, int> vertices_per_piece;
     for (int piece : components[l]) ++vertices_per_piece[piece];
     EXPECT_GE(vertices_per_piece[0], 1) << "level " << l;
@@ -363,7 +412,7 @@ TEST(Multigrid, AfterACutTheKeptLevelsAreTheGalerkinOperatorsOfTheNewMatrix) {
   const std::vector<VertexId> origins = origins_of_new_vertices(report, before, after);
   const test::LinearSystem cut = test::clamped_system(model, test::Clamp::both_ends);
 
-  reference.replace_fine_level(cut.a, to_block_sparse<double>(cut.a), origins, options.smoother);
+  reference.replace_fine_level(to_block_sparse<double>(cut.a), origins, options.smoother);
   const MultigridLevel& fine = reference.levels()[0];
   EXPECT_EQ(fine.from_coarser.fine_count(), after);
   const SparseMatrix galerkin = galerkin_operator(cut.a, fine.fixed, fine.from_coarser);
@@ -402,13 +451,13 @@ TEST(Multigrid, ReplacingTheFineLevelRefusesOriginsOutsideTheOldLevel) {
   grown.setFromTriplets(entries.begin(), entries.end());
   grown.makeCompressed();
   try {
-    m.replace_fine_level(grown, to_block_sparse<double>(grown), {n + 5}, options.smoother);
+    m.replace_fine_level(to_block_sparse<double>(grown), {n + 5}, options.smoother);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), fmt::format("multigrid: a divided vertex's origin is {}; expected a vertex of the old fine level (0 to {})", n + 5, n - 1));
   }
   try {
-    m.replace_fine_level(s.a, to_block_sparse<double>(s.a), {0}, options.smoother);
+    m.replace_fine_level(to_block_sparse<double>(s.a), {0}, options.smoother);
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_EQ(std::string(e.what()), fmt::format("multigrid: the new fine matrix has {} rows; expected {} ({} vertices and 1 copies, 3 dofs each)",

@@ -35,7 +35,7 @@ void update_stiffness_after_cut(const TissueModel& model, const CutReport& repor
   const std::vector<std::uint8_t> affected = vertices_affected_by_cut(model.volume, report);
   SparseMatrix updated = rebuild_vertex_block_pattern(model.volume, stiffness, affected);
   gather_rows(model, make_element_table(model), &affected, updated);
-  stiffness = std::move(updated);
+  stiffness.swap(updated);  // Eigen 3.4's SparseMatrix has no move assignment: std::move would copy
 }
 
 }  // namespace cleave

@@ -59,7 +59,8 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
     pattern_current_ = false;
     if (!settings_.matrix_free) ensure_pattern();
   } else {
-    system_ = make_vertex_block_pattern(model_.volume);
+    SparseMatrix pattern = make_vertex_block_pattern(model_.volume);
+    system_.swap(pattern);  // Eigen 3.4's SparseMatrix has no move: assigning the temporary would copy it
     rows_to_pattern_.clear();
     pattern_current_ = false;
     ensure_pattern();
@@ -71,7 +72,10 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
 
 void Dynamics::ensure_pattern() {
   if (pattern_current_) return;
-  if (!rows_to_pattern_.empty()) system_ = rebuild_vertex_block_pattern(model_.volume, system_, rows_to_pattern_);
+  if (!rows_to_pattern_.empty()) {
+    SparseMatrix rebuilt = rebuild_vertex_block_pattern(model_.volume, system_, rows_to_pattern_);
+    system_.swap(rebuilt);  // no move in Eigen 3.4's SparseMatrix: a swap instead of a copy
+  }
   rows_to_pattern_.clear();
   system_blocks_ = to_block_sparse<double>(system_);
   gather_ = make_vertex_block_gather(model_.volume, system_blocks_);

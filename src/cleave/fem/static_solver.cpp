@@ -2,6 +2,8 @@
 
 #include <fmt/format.h>
 
+#include <utility>
+
 #include "cleave/core/error.hpp"
 #include "cleave/fem/assemble_stiffness.hpp"
 #include "cleave/fem/lumped_mass.hpp"
@@ -13,7 +15,8 @@ StaticSolver::StaticSolver(const TissueModel& model, const StaticOptions& option
     : StaticSolver(model, assemble_stiffness(model), options) {}
 
 StaticSolver::StaticSolver(const TissueModel& model, SparseMatrix stiffness, const StaticOptions& options)
-    : model_(model), options_(options), eliminated_(std::move(stiffness)) {
+    : model_(model), options_(options) {
+  eliminated_.swap(stiffness);  // Eigen 3.4's SparseMatrix has no move constructor: std::move would copy
   const LinkedVolume& volume = model.volume;
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (eliminated_.rows() != dofs)
@@ -30,7 +33,8 @@ StaticSolver::StaticSolver(const TissueModel& model, SparseMatrix stiffness, con
 
 void StaticSolver::set_up_solver() {
   if (set_up_) return;
-  solver_->setup(eliminated_, model_.volume);
+  solver_->setup_taking(std::move(eliminated_), model_.volume);  // the solver keeps what it needs of it
+  eliminated_ = SparseMatrix();  // emptied whether or not the solver swapped it out
   set_up_ = true;
 }
 

@@ -50,7 +50,7 @@ class StaticSolver {
 
   const TissueModel& model_;
   StaticOptions options_;
-  SparseMatrix eliminated_;  ///< K with the held dofs' rows and columns replaced by identity
+  SparseMatrix eliminated_;  ///< K with the held dofs' rows and columns replaced by identity; given to the solver at set-up
   Vector fixed_load_;        ///< the right-hand side that elimination makes of a zero load
   FixedDofs fixed_;
   RigidSupportReport supports_;

@@ -168,6 +168,21 @@ void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a) {
   });
 }
 
+SparseMatrix to_scalar_sparse(const BlockSparseMatrix<double>& b) {
+  SparseMatrix a(b.rows(), b.rows());
+  std::vector<Eigen::Triplet<double>> entries;
+  entries.reserve(b.values.size());
+  for (Eigen::Index v = 0; v < b.block_rows(); ++v)
+    for (auto k = static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v)]);
+         k < static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v) + 1]); ++k)
+      for (int i = 0; i < 3; ++i)
+        for (int j = 0; j < 3; ++j)
+          entries.emplace_back(3 * v + i, 3 * static_cast<Eigen::Index>(b.column[k]) + j, b.values[9 * k + 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(j)]);
+  a.setFromTriplets(entries.begin(), entries.end());
+  a.makeCompressed();
+  return a;
+}
+
 namespace {
 
 /// sum over the blocks of row v of A_vw x_w (any scalar; the reference for the vector kernels).

@@ -45,6 +45,10 @@ void refresh_block_values(const SparseMatrix& a, BlockSparseMatrix<Scalar>& b);
 /// (to_block_sparse(a)); entries of b outside a's pattern are not written.
 void copy_block_values(const BlockSparseMatrix<double>& b, SparseMatrix& a);
 
+/// Scalar CSR (compressed RowMajor) with every entry of every stored block, zeros included: the
+/// multigrid's coarsest factorization when the fine level is the only one.
+SparseMatrix to_scalar_sparse(const BlockSparseMatrix<double>& b);
+
 template <typename Scalar>
 void multiply(const BlockSparseMatrix<Scalar>& a, const typename BlockSparseMatrix<Scalar>::VectorType& x,
               typename BlockSparseMatrix<Scalar>::VectorType& y);

@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <utility>
 #include <optional>
 #include <vector>
 
@@ -29,8 +30,10 @@ class CholmodSolver final : public LinearSolver {
   CholmodSolver(const CholmodSolver&) = delete;
   CholmodSolver& operator=(const CholmodSolver&) = delete;
 
-  void setup(const SparseMatrix& a, const LinkedVolume& /*topology*/) override {
-    a_ = a;
+  void setup(const SparseMatrix& a, const LinkedVolume& topology) override { setup_taking(SparseMatrix(a), topology); }
+
+  void setup_taking(SparseMatrix&& a, const LinkedVolume& /*topology*/) override {
+    a_.swap(a);  // Eigen 3.4's SparseMatrix has no move assignment: std::move would copy
     a_.makeCompressed();
     const auto n = static_cast<std::size_t>(a_.rows());
     // A symmetric CSR matrix read as CSC is the same matrix; stype 1 reads its upper triangle.

@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <Eigen/IterativeLinearSolvers>
+#include <utility>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
@@ -14,8 +15,10 @@ class EigenCgSolver final : public LinearSolver {
  public:
   explicit EigenCgSolver(const SolveSettings& settings) : settings_(settings) {}
 
-  void setup(const SparseMatrix& a, const LinkedVolume& /*topology*/) override {
-    a_ = a;
+  void setup(const SparseMatrix& a, const LinkedVolume& topology) override { setup_taking(SparseMatrix(a), topology); }
+
+  void setup_taking(SparseMatrix&& a, const LinkedVolume& /*topology*/) override {
+    a_.swap(a);  // Eigen 3.4's SparseMatrix has no move assignment: std::move would copy
     a_.makeCompressed();
     cg_.setTolerance(settings_.relative_tolerance);
     cg_.setMaxIterations(settings_.max_iterations);

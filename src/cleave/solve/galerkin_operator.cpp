@@ -102,6 +102,28 @@ std::vector<std::uint8_t> identity_rows(const SparseMatrix& a) {
   return fixed;
 }
 
+std::vector<std::uint8_t> identity_rows(const BlockSparseMatrix<double>& a) {
+  std::vector<std::uint8_t> fixed(static_cast<std::size_t>(a.rows()), 0);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, a.block_rows(), 1024), [&](const tbb::blocked_range<Eigen::Index>& range) {
+    for (Eigen::Index v = range.begin(); v < range.end(); ++v) {
+      const auto first = static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v)]);
+      const auto last = static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v) + 1]);
+      for (std::size_t i = 0; i < 3; ++i) {
+        bool identity = true;
+        bool has_diagonal = false;
+        for (std::size_t k = first; k < last && identity; ++k)
+          for (std::size_t j = 0; j < 3; ++j) {
+            const double value = a.values[9 * k + 3 * i + j];
+            if (a.column[k] == v && j == i) has_diagonal = value != 0;
+            else if (value != 0) identity = false;
+          }
+        fixed[3 * static_cast<std::size_t>(v) + i] = identity && has_diagonal ? 1 : 0;
+      }
+    }
+  });
+  return fixed;
+}
+
 SparseMatrix galerkin_operator(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed, const Prolongation& p) {
   return galerkin_operator(to_block_sparse<double>(a), fixed, p);
 }

@@ -28,5 +28,8 @@ SparseMatrix galerkin_operator(const BlockSparseMatrix<double>& a, const std::ve
 
 /// Dofs whose row in `a` is an identity row (no off-diagonal entry other than zero): fixed dofs.
 std::vector<std::uint8_t> identity_rows(const SparseMatrix& a);
+/// The same for `a` as block CSR: row 3 v + i is an identity row when entry (i, i) of block (v, v)
+/// is not zero and every other entry of row i of block row v's blocks is zero.
+std::vector<std::uint8_t> identity_rows(const BlockSparseMatrix<double>& a);
 
 }  // namespace cleave

@@ -62,6 +62,10 @@ class LinearSolver {
   /// Prepares for A (factorization, hierarchy). `topology` is the linked volume whose vertices
   /// the dofs belong to; it must stay alive and unchanged until the next setup.
   virtual void setup(const SparseMatrix& a, const LinkedVolume& topology) = 0;
+  /// setup() with a matrix the caller gives away (StaticSolver's eliminated stiffness, ~1 GB at
+  /// 350k cells): a solver that keeps the scalar matrix takes this one instead of copying it.
+  /// The default sets up from it as setup() does.
+  virtual void setup_taking(SparseMatrix&& a, const LinkedVolume& topology) { setup(a, topology); }
   /// Like setup() for a matrix with the same sparsity pattern and topology as the last setup and
   /// new values (the next time step's corotated stiffness). Solvers keep what depends only on
   /// the pattern (CHOLMOD's symbolic analysis, the multigrid's levels, which it refreshes only

@@ -34,24 +34,29 @@ class MultigridCgSolver final : public LinearSolver {
   MultigridCgSolver(const SolveSettings& settings, const MultigridOptions& options) : settings_(settings), options_(options) {}
 
   void setup(const SparseMatrix& a, const LinkedVolume& topology) override {
-    preconditioner_ = MultigridPreconditioner();  // drops the reference to the old matrix first
-    operator_ = nullptr;
-    a_ = a;
-    a_.makeCompressed();
-    rows_ = a_.rows();
-    a_blocks_ = to_block_sparse<double>(a_);
+    take_blocks_of(a);
+    build(topology);
+  }
+
+  /// The scalar matrix is let go as soon as its blocks are made, before the levels are built:
+  /// the set-up's peak holds one copy of the fine matrix fewer.
+  void setup_taking(SparseMatrix&& a, const LinkedVolume& topology) override {
+    take_blocks_of(a);
+    {
+      SparseMatrix released;
+      released.swap(a);
+    }
     build(topology);
   }
 
   void update_values(const SparseMatrix& a, const LinkedVolume& topology) override {
-    const bool same_pattern = a.isCompressed() && a.rows() == a_.rows() && a.nonZeros() == a_.nonZeros() &&
-                              std::equal(a_.outerIndexPtr(), a_.outerIndexPtr() + a_.rows() + 1, a.outerIndexPtr());
+    const bool same_pattern = a.isCompressed() && a.rows() == rows_ && a.nonZeros() == pattern_nonzeros_ &&
+                              std::equal(pattern_row_start_.begin(), pattern_row_start_.end(), a.outerIndexPtr(),
+                                         a.outerIndexPtr() + a.rows() + 1);
     if (!same_pattern || rebuild_requested_ || stale_updates_ >= options_.max_stale_updates) {
       setup(a, topology);
       return;
     }
-    // Only the block copy follows the new values: a_ (scalar CSR) is what the levels were built
-    // from and is read again only by the next setup.
     refresh_block_values(a, a_blocks_);
     operator_ = nullptr;
     preconditioner_.refresh_fine_level(a_blocks_);
@@ -90,9 +95,9 @@ class MultigridCgSolver final : public LinearSolver {
     preconditioner_.replace_fine_level(a, a.inverse_diagonal_blocks(), origin_of_new, options_.smoother);
     operator_ = &a;
     rows_ = a.rows();
-    // The matrices of the old topology are of no further use: a rebuild assembles the operator.
-    a_ = SparseMatrix();
+    // The matrix of the old topology is of no further use: a rebuild assembles the operator.
     a_blocks_ = BlockSparseMatrix<double>();
+    pattern_row_start_.clear();
     ++stale_updates_;
     topology_ = &topology;
     return true;
@@ -123,13 +128,12 @@ class MultigridCgSolver final : public LinearSolver {
     // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
     preconditioner_ = MultigridPreconditioner();
     if (operator_ != nullptr) {
-      a_ = operator_->assembled_matrix();
-      a_blocks_ = to_block_sparse<double>(a_);
+      const SparseMatrix assembled = operator_->assembled_matrix();
+      a_blocks_ = to_block_sparse<double>(assembled);
+      remember_pattern(assembled);
       operator_ = nullptr;
-    } else {
-      copy_block_values(a_blocks_, a_);
     }
-    build(*topology_);
+    build(*topology_);  // the blocks hold the current values (update_values and update_block_values keep them so)
     const SolveSettings rest = continuation(settings_, stale, settings_.max_iterations - stale.iterations);
     SolveReport report = solve_with(b, x, rest);
     baseline_iterations_ = report.iterations;
@@ -142,7 +146,7 @@ class MultigridCgSolver final : public LinearSolver {
 
  private:
   void build(const LinkedVolume& topology) {
-    preconditioner_ = build_multigrid(a_, topology, options_, &a_blocks_);
+    preconditioner_ = build_multigrid(a_blocks_, topology, options_);
     topology_ = &topology;
     stale_updates_ = 0;
     baseline_iterations_ = -1;
@@ -159,11 +163,11 @@ class MultigridCgSolver final : public LinearSolver {
       setup(a, topology);
       return;
     }
-    a_ = a;
-    rows_ = a_.rows();
+    rows_ = a.rows();
     operator_ = nullptr;
-    a_blocks_ = blocks != nullptr ? *blocks : to_block_sparse<double>(a_);
-    preconditioner_.replace_fine_level(a_, a_blocks_, origin_of_new, options_.smoother);
+    a_blocks_ = blocks != nullptr ? *blocks : to_block_sparse<double>(a);
+    remember_pattern(a);
+    preconditioner_.replace_fine_level(a_blocks_, origin_of_new, options_.smoother);
     ++stale_updates_;
     topology_ = &topology;
   }
@@ -232,6 +236,31 @@ class MultigridCgSolver final : public LinearSolver {
     return preconditioned_cg(a_blocks_, b, x, preconditioner_, settings);
   }
 
+  /// Drops the levels and the old matrix, then makes the block copy of `a` (compressed first when
+  /// it is not) that the levels are built from.
+  void take_blocks_of(const SparseMatrix& a) {
+    preconditioner_ = MultigridPreconditioner();
+    operator_ = nullptr;
+    a_blocks_ = BlockSparseMatrix<double>();  // the old copy goes before the new one is made
+    if (a.isCompressed()) {
+      a_blocks_ = to_block_sparse<double>(a);
+      remember_pattern(a);
+    } else {
+      SparseMatrix compressed = a;
+      compressed.makeCompressed();
+      a_blocks_ = to_block_sparse<double>(compressed);
+      remember_pattern(compressed);
+    }
+    rows_ = a.rows();
+  }
+
+  /// The scalar pattern's row starts and size, against which update_values() checks that a new
+  /// matrix has the pattern the blocks were made from (the scalar matrix itself is not kept).
+  void remember_pattern(const SparseMatrix& a) {
+    pattern_row_start_.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1);
+    pattern_nonzeros_ = a.nonZeros();
+  }
+
   /// Remembers the first solve's iterations after a build; a solve far above them asks for a
   /// rebuild at the next update.
   SolveReport track(const SolveReport& report) {
@@ -242,10 +271,11 @@ class MultigridCgSolver final : public LinearSolver {
 
   SolveSettings settings_;
   MultigridOptions options_;
-  SparseMatrix a_;                      ///< the matrix of the last setup (the levels' source)
-  BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the CG multiplies with ...
+  BlockSparseMatrix<double> a_blocks_;  ///< the current matrix as block CSR: what the levels are built from and CG multiplies with ...
   const VertexOperator* operator_ = nullptr;  ///< ... unless the last update gave the matrix as an operator
-  Eigen::Index rows_ = 0;  ///< of the current matrix (a_ is empty after a topology update by operator)
+  Eigen::Index rows_ = 0;  ///< of the current matrix (a_blocks_ is empty after a topology update by operator)
+  std::vector<SparseMatrix::StorageIndex> pattern_row_start_;  ///< see remember_pattern()
+  Eigen::Index pattern_nonzeros_ = 0;
   MultigridPreconditioner preconditioner_;
   int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
   int baseline_iterations_ = -1;  ///< iterations of the first solve after the build

@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <Eigen/SparseCholesky>
+#include <algorithm>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
@@ -124,17 +125,19 @@ void transpose_prolongation(Prolongation& p) {
 
 }  // namespace
 
-MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options,
-                                        const BlockSparseMatrix<double>* a_blocks) {
-  const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
-  if (a.rows() != dofs || a.cols() != dofs)
-    throw InputError(fmt::format("multigrid: matrix is {} x {}; expected {} x {} (3 dofs per vertex of the linked volume)",
-                                 a.rows(), a.cols(), dofs, dofs));
-  if (a_blocks != nullptr && a_blocks->rows() != dofs)
-    throw InputError(fmt::format("multigrid: the block copy of the matrix has {} rows; expected {}", a_blocks->rows(), dofs));
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options) {
   if (!a.isCompressed()) throw InputError("multigrid: matrix must be compressed (makeCompressed)");
+  if (a.rows() != a.cols())
+    throw InputError(fmt::format("multigrid: matrix is {} x {}; expected a square matrix with 3 dofs per vertex", a.rows(), a.cols()));
+  return build_multigrid(to_block_sparse<double>(a), volume, options);
+}
+
+MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume, const MultigridOptions& options) {
+  const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
+  if (a.rows() != dofs)
+    throw InputError(fmt::format("multigrid: matrix has {} rows; expected {} (3 dofs per vertex of the linked volume)", a.rows(), dofs));
   MultigridPreconditioner m;
-  m.fine_ = &a;
+  m.levels_.reserve(static_cast<std::size_t>(std::max(options.max_levels, 1)));  // no reallocation: it would copy the levels' matrices
   GridLevel grid = grid_level_of(volume);
   {
     MultigridLevel fine;
@@ -143,18 +146,19 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
   }
   while (static_cast<int>(m.levels_.size()) < options.max_levels) {
     const std::size_t l = m.levels_.size() - 1;
-    const SparseMatrix& current = m.operator_of(l);
-    if (current.rows() <= options.coarsest_max_dofs) break;
+    const Eigen::Index rows = l == 0 ? a.rows() : m.levels_[l].matrix.rows();
+    if (rows <= options.coarsest_max_dofs) break;
     Coarsening next = coarsen_grid_level(grid);
     const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
     if (ratio > options.min_coarsening_ratio) break;
-    MultigridLevel coarse;
-    coarse.matrix = l == 0 && a_blocks != nullptr ? galerkin_operator(*a_blocks, m.levels_[l].fixed, next.prolongation)
-                                                  : galerkin_operator(current, m.levels_[l].fixed, next.prolongation);
-    coarse.fixed = identity_rows(coarse.matrix);
+    // Built in place: Eigen 3.4's SparseMatrix has no move, so assigning or moving one copies it.
+    SparseMatrix galerkin = l == 0 ? galerkin_operator(a, m.levels_[l].fixed, next.prolongation)
+                                   : galerkin_operator(m.levels_[l].matrix, m.levels_[l].fixed, next.prolongation);
     m.levels_[l].from_coarser = std::move(next.prolongation);
     grid = std::move(next.coarse);
-    m.levels_.push_back(std::move(coarse));
+    MultigridLevel& coarse = m.levels_.emplace_back();
+    coarse.matrix.swap(galerkin);
+    coarse.fixed = identity_rows(coarse.matrix);
   }
   m.precision_ = options.precision;
   if (options.coarse_degree < 1)
@@ -164,16 +168,16 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
     ChebyshevOptions smoother = options.smoother;
     if (l > 0) smoother.degree = options.coarse_degree;
     if (m.precision_ == CyclePrecision::single_precision) {
-      level.single.blocks = to_block_sparse<float>(m.operator_of(l));
+      level.single.blocks = l == 0 ? single_precision_copy(a) : to_block_sparse<float>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.single.blocks, smoother);
     } else {
-      level.twin.blocks = to_block_sparse<double>(m.operator_of(l));
+      level.twin.blocks = l == 0 ? a : to_block_sparse<double>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.twin.blocks, smoother);
     }
   }
 
   m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
-  const Eigen::SparseMatrix<double> coarsest(m.operator_of(m.levels_.size() - 1));
+  const Eigen::SparseMatrix<double> coarsest(m.levels_.size() == 1 ? to_scalar_sparse(a) : m.levels_.back().matrix);
   m.coarsest_->ldlt.compute(coarsest);
   if (m.coarsest_->ldlt.info() != Eigen::Success) {
     const double shift = kCoarsestShift * coarsest.diagonal().cwiseAbs().mean();
@@ -268,24 +272,27 @@ void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::v
   }
 }
 
-void MultigridPreconditioner::replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
-                                                 const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother) {
-  if (blocks.rows() != a.rows())
-    throw InputError(fmt::format("multigrid: the block copy of the new fine matrix has {} rows; the matrix has {}", blocks.rows(), a.rows()));
+void MultigridPreconditioner::replace_fine_level(const BlockSparseMatrix<double>& a, const std::vector<VertexId>& origin_of_new,
+                                                 const ChebyshevOptions& smoother) {
   extend_fine_prolongation(origin_of_new, a.rows());
   MultigridLevel& fine = levels_[0];
-  fine_ = &a;
   fine_operator_ = nullptr;
   fine.fixed = identity_rows(a);
   if (precision_ == CyclePrecision::single_precision) {
-    fine.single.blocks = single_precision_copy(blocks);
+    fine.single.blocks = single_precision_copy(a);
     fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother);
     allocate_cycle<float>();
   } else {
-    fine.twin.blocks = blocks;
+    fine.twin.blocks = a;
     fine.smoother = make_chebyshev_smoother(fine.twin.blocks, smoother);
     allocate_cycle<double>();
   }
+}
+
+const SparseMatrix& MultigridPreconditioner::coarse_operator(std::size_t level) const {
+  if (level == 0 || level >= levels_.size())
+    throw InputError(fmt::format("multigrid: level {} has no coarse operator; expected 1 to {}", level, levels_.size() - 1));
+  return levels_[level].matrix;
 }
 
 void MultigridPreconditioner::use_fine_operator(const VertexOperator& a, std::vector<Mat3> inverse_diagonal) {

@@ -10,9 +10,10 @@
 //   MultigridPreconditioner m = build_multigrid(a, volume);   // a: 3 n_v x 3 n_v on volume's vertices
 //   m.apply(r, z);                                            // z = one V-cycle on A z = r from z = 0
 //
-// Inputs: a compressed RowMajor, symmetric positive definite (fixed dofs as identity rows), rows
-// 3 v + axis for the volume's current vertices; `a` is referenced, not copied, and must outlive
-// the preconditioner. Throws InputError when the sizes do not match.
+// Inputs: a symmetric positive definite matrix (fixed dofs as identity rows), rows 3 v + axis for
+// the volume's current vertices, as block CSR or as compressed RowMajor scalar CSR (converted to
+// blocks once). Neither is referenced after the build: the levels keep their own copies in the
+// cycle's precision. Throws InputError when the sizes do not match.
 // apply() uses internal work vectors: one apply at a time per object.
 #include <memory>
 #include <type_traits>
@@ -72,7 +73,7 @@ struct CycleData {
 
 /// One level: its operator, smoother, and the prolongation from the next coarser level.
 struct MultigridLevel {
-  SparseMatrix matrix;              ///< coarse levels only; level 0 uses the referenced fine matrix
+  SparseMatrix matrix;              ///< coarse levels only (level 0 keeps its operator as blocks only)
   std::vector<std::uint8_t> fixed;  ///< per dof: identity row
   ChebyshevSmoother smoother;
   Prolongation from_coarser;        ///< empty on the coarsest level
@@ -103,7 +104,7 @@ class MultigridPreconditioner final : public Preconditioner {
   /// Gives the fine level's smoother the values of `a` (the matrix built from, as block CSR,
   /// with new values: same pattern and fixed dofs) and their block diagonal; the coarse levels,
   /// the smoothers' eigenvalue bounds and the coarsest factorization stay those of the older
-  /// matrix, and so does operator_of(0).
+  /// matrix.
   void refresh_fine_level(const BlockSparseMatrix<double>& a);
 
   /// From now on the fine level applies `a` without its matrix (the dynamic step's system with
@@ -115,30 +116,30 @@ class MultigridPreconditioner final : public Preconditioner {
   bool uses_fine_operator() const { return fine_operator_ != nullptr; }
 
   /// Replaces the fine level after cuts divided vertices (LinearSolver::update_topology): `a` is
-  /// the new fine matrix (kept referenced, like the one built from), `blocks` the same as block
-  /// CSR, vertex `n + i` of it a copy of the old fine vertex `origin_of_new[i]`. Each copy gets
-  /// its origin's prolongation row; the fine level's fixed dofs, block diagonal and eigenvalue
-  /// bound are those of `a`; the coarse levels and the coarsest factorization stay. Needs at
-  /// least two levels (throws InputError otherwise, and for origins or sizes that do not fit).
-  void replace_fine_level(const SparseMatrix& a, const BlockSparseMatrix<double>& blocks,
-                          const std::vector<VertexId>& origin_of_new, const ChebyshevOptions& smoother);
+  /// the new fine matrix as block CSR (copied in the cycle's precision), vertex `n + i` of it a
+  /// copy of the old fine vertex `origin_of_new[i]`. Each copy gets its origin's prolongation
+  /// row; the fine level's fixed dofs, block diagonal and eigenvalue bound are those of `a`; the
+  /// coarse levels and the coarsest factorization stay. Needs at least two levels (throws
+  /// InputError otherwise, and for origins or sizes that do not fit).
+  void replace_fine_level(const BlockSparseMatrix<double>& a, const std::vector<VertexId>& origin_of_new,
+                          const ChebyshevOptions& smoother);
 
   /// replace_fine_level for the new fine matrix applied without its values (the dynamic step's
   /// system after a cut): the fine level applies `a` (referenced, it must outlive the use) with
   /// its D^-1 `inverse_diagonal` and fixed dofs, its eigenvalue bound by power iteration on `a`;
-  /// the coarse levels and the coarsest factorization stay. operator_of(0) is then no longer the
-  /// fine matrix (a rebuild sets up afresh). Throws InputError as replace_fine_level.
+  /// the coarse levels and the coarsest factorization stay. Throws InputError as replace_fine_level.
   void replace_fine_level(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const std::vector<VertexId>& origin_of_new,
                           const ChebyshevOptions& smoother);
 
   /// Level 0 is the fine level; the last level is solved directly.
   const std::vector<MultigridLevel>& levels() const { return levels_; }
-  /// The operator of a level (level 0: the referenced fine matrix).
-  const SparseMatrix& operator_of(std::size_t level) const { return level == 0 ? *fine_ : levels_[level].matrix; }
+  /// The Galerkin operator of a coarse level (1 and up; the fine level's matrix is not kept as
+  /// scalar CSR: InputError for level 0 and for levels past the last).
+  const SparseMatrix& coarse_operator(std::size_t level) const;
 
  private:
-  friend MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume,
-                                                 const MultigridOptions& options, const BlockSparseMatrix<double>* a_blocks);
+  friend MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume,
+                                                 const MultigridOptions& options);
   struct CoarsestSolver;
   template <typename Scalar>
   void cycle(std::size_t level) const;
@@ -151,17 +152,16 @@ class MultigridPreconditioner final : public Preconditioner {
   /// changes anything: on InputError the levels are as they were.
   void extend_fine_prolongation(const std::vector<VertexId>& origin_of_new, Eigen::Index new_rows);
 
-  const SparseMatrix* fine_ = nullptr;
   const VertexOperator* fine_operator_ = nullptr;  ///< when set, the fine level's operator instead of its blocks
   std::vector<MultigridLevel> levels_;
   std::unique_ptr<CoarsestSolver> coarsest_;
   CyclePrecision precision_ = CyclePrecision::single_precision;
 };
 
-/// `a_blocks`: `a` as block CSR when the caller keeps that copy anyway (the multigrid CG solver):
-/// the first Galerkin product then reads it instead of converting `a` once more.
-MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {},
-                                        const BlockSparseMatrix<double>* a_blocks = nullptr);
+MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume,
+                                        const MultigridOptions& options = {});
+/// The same from scalar CSR (compressed, RowMajor; InputError otherwise).
+MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {});
 
 /// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
 void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
