@@ -67,7 +67,8 @@ nlohmann::json model_figures_json(const ModelFigures& figures, const MachineFigu
   j["machine"] = {{"cpu", machine.cpu},
                   {"threads", machine.threads},
                   {"bandwidth_GB_per_s", machine.bandwidth.all_threads_GB_per_s},
-                  {"bandwidth_one_thread_GB_per_s", machine.bandwidth.one_thread_GB_per_s}};
+                  {"bandwidth_one_thread_GB_per_s", machine.bandwidth.one_thread_GB_per_s},
+                  {"malloc_huge_pages", machine.malloc_huge_pages}};
   if (figures.model.paper) {
     const PaperFigures& p = *figures.model.paper;
     j["paper_2012"] = {{"cells", p.cells}, {"vertices", p.vertices}, {"ms_vector", p.ms_vector},

@@ -23,6 +23,7 @@ struct MachineFigures {
   std::string cpu;                    ///< model name from /proc/cpuinfo
   int threads = 1;                    ///< TBB workers
   MemoryBandwidth bandwidth;
+  bool malloc_huge_pages = false;     ///< the heap in transparent huge pages (core/allocator_tuning.hpp)
 };
 
 /// CPU model name ("model name" of /proc/cpuinfo), or "unknown".

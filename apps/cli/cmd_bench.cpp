@@ -18,6 +18,7 @@
 
 #include "bench_models.hpp"
 #include "bench_report.hpp"
+#include "cleave/core/allocator_tuning.hpp"
 #include "cleave/core/error.hpp"
 #include "command_registry.hpp"
 #include "measure_model.hpp"
@@ -127,6 +128,7 @@ int run_bench(const BenchArguments& args) {
   report(progress, "memory bandwidth", 0.0);
   bench::MachineFigures machine;
   machine.cpu = bench::cpu_model_name();
+  machine.malloc_huge_pages = malloc_uses_huge_pages();
   bench::BandwidthOptions bandwidth_options;
   if (args.quick) bandwidth_options.elements_per_array = kQuickBandwidthElements;
   machine.bandwidth = bench::measure_memory_bandwidth(bandwidth_options);
