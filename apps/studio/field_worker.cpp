@@ -50,6 +50,7 @@ std::uint64_t FieldWorker::submit(Job job) {
   {
     std::lock_guard lock(mutex_);
     generation = latest_.fetch_add(1) + 1;
+    if (pending_) skipped_.fetch_add(1);  // the queued job never starts
     pending_ = std::move(job);
     pending_generation_ = generation;
   }

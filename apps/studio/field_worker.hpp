@@ -79,6 +79,10 @@ class FieldWorker {
   void stop();
   /// Jobs actually started so far (superseded queued jobs never start).
   std::uint64_t jobs_started() const { return started_.load(); }
+  /// Queued jobs replaced by a newer one before they started. Every submitted job is started or
+  /// skipped (once the worker is idle: submitted = started + skipped).
+  std::uint64_t jobs_skipped() const { return skipped_.load(); }
+  std::uint64_t jobs_submitted() const { return latest_.load(); }
 
  private:
   using Clock = std::chrono::steady_clock;
@@ -98,6 +102,7 @@ class FieldWorker {
   std::uint64_t pending_generation_ = 0;
   std::atomic<std::uint64_t> latest_{0};
   std::atomic<std::uint64_t> started_{0};
+  std::atomic<std::uint64_t> skipped_{0};
   bool busy_ = false;
   bool stopping_ = false;
 

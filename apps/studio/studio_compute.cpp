@@ -78,13 +78,16 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
   server_token_ = fmt::format("{:08x}{:08x}", entropy(), entropy());
   worker_ = std::make_unique<FieldWorker>(
       [this](FieldWorker::Result r) {
-        // How much work the edits caused: a burst of edits starts fewer computations than edits
-        // (the worker drops stale ones), which the page and its tests can see.
+        // How much work the edits caused: an edit that arrives while another's work runs replaces
+        // the queued one, which then never starts (skipped); the page and its tests can see it.
         if (r.message.value("type", "") != "result") {
           send_(wire_encoded(r.message));
           return;
         }
-        r.message["computations"] = {{"started", worker_->jobs_started()}, {"published", ++results_published_}};
+        r.message["computations"] = {{"submitted", worker_->jobs_submitted()},
+                                     {"started", worker_->jobs_started()},
+                                     {"skipped", worker_->jobs_skipped()},
+                                     {"published", ++results_published_}};
         // The connected clients hold the triangles of the surface they were last sent (every
         // result reaches every client; one that connects later gets latest_result_ in full).
         nlohmann::json& surface = r.message["surface"];

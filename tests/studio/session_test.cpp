@@ -165,6 +165,8 @@ TEST(FieldWorker, NewerJobsSupersedeOlderOnesAndOnlyCurrentResultsArePublished) 
   worker.wait_idle();
   EXPECT_EQ(last, 9u);
   EXPECT_EQ(worker.jobs_started(), 2u) << "the job in flight and the newest one; none of the stale ones";
+  EXPECT_EQ(worker.jobs_skipped(), 7u) << "jobs 2 to 8, each replaced in the queue by the next";
+  EXPECT_EQ(worker.jobs_submitted(), 9u);
   ASSERT_EQ(published.size(), 1u) << "the superseded job's result is discarded";
   EXPECT_EQ(published[0], 9u);
 }
