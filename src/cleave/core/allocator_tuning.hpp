@@ -23,6 +23,8 @@ void keep_freed_memory_for_reuse();
 /// process id stays). Call first thing in `main`. Returns without restarting when the tunable is
 /// set already (by an earlier start or by the user), when CLEAVE_HUGE_PAGES=0, where the C
 /// library is not glibc 2.35 or later on Linux, under AddressSanitizer, or when the exec fails.
+/// Tools that do not follow an exec (valgrind without --trace-children=yes) need
+/// CLEAVE_HUGE_PAGES=0, or they lose the program at the restart.
 void restart_with_huge_pages(char** argv);
 
 /// Whether this process's malloc asks for transparent huge pages (see restart_with_huge_pages).
