@@ -13,6 +13,7 @@
 
 #include "bench_models.hpp"
 #include "bench_scenario.hpp"
+#include "cleave/core/address_sanitizer.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
 #include "timing_statistics.hpp"
@@ -33,18 +34,6 @@ constexpr double kFrameAgreementTolerance = 1e-3;
 // The step's accuracy against a 1e-12 solve is asserted over 100 steps in
 // tests/fem/dynamics_step_tolerance_test.cpp; here a real disagreement (a wrong system) is O(1).
 constexpr double kStepAgreementTolerance = 2e-2;
-
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kAddressSanitizer = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kAddressSanitizer = true;
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
-#else
-constexpr bool kAddressSanitizer = false;
-#endif
 
 std::vector<nlohmann::json> run_quick_bench(const std::string& arguments = "--quick", const std::string& environment = "") {
   const std::string command = environment + std::string(CLEAVE_CLI_PATH) + " bench " + arguments + " --json --quiet";

@@ -14,20 +14,12 @@
 #include <sstream>
 #include <string>
 
+#include "cleave/core/address_sanitizer.hpp"
+
 namespace cleave {
 namespace {
 
-#if defined(__SANITIZE_ADDRESS__)
-constexpr bool kSanitizerAllocator = true;
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-constexpr bool kSanitizerAllocator = true;
-#else
-constexpr bool kSanitizerAllocator = false;
-#endif
-#else
-constexpr bool kSanitizerAllocator = false;
-#endif
+constexpr bool kSanitizerAllocator = kAddressSanitizer;  // ASan brings its own allocator
 
 constexpr std::size_t kPageBytes = 4096;
 constexpr std::size_t kBlockBytes = std::size_t{256} << 20;  // well above glibc's 32 MB mapping threshold

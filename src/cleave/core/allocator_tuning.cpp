@@ -11,13 +11,7 @@
 #include <unistd.h>
 #endif
 
-#if defined(__SANITIZE_ADDRESS__)
-#define CLEAVE_ADDRESS_SANITIZER 1
-#elif defined(__has_feature)
-#if __has_feature(address_sanitizer)
-#define CLEAVE_ADDRESS_SANITIZER 1
-#endif
-#endif
+#include "cleave/core/address_sanitizer.hpp"
 
 namespace cleave {
 namespace {
