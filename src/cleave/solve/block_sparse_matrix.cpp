@@ -172,12 +172,16 @@ SparseMatrix to_scalar_sparse(const BlockSparseMatrix<double>& b) {
   SparseMatrix a(b.rows(), b.rows());
   std::vector<Eigen::Triplet<double>> entries;
   entries.reserve(b.values.size());
-  for (Eigen::Index v = 0; v < b.block_rows(); ++v)
-    for (auto k = static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v)]);
-         k < static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v) + 1]); ++k)
-      for (int i = 0; i < 3; ++i)
-        for (int j = 0; j < 3; ++j)
-          entries.emplace_back(3 * v + i, 3 * static_cast<Eigen::Index>(b.column[k]) + j, b.values[9 * k + 3 * static_cast<std::size_t>(i) + static_cast<std::size_t>(j)]);
+  for (Eigen::Index v = 0; v < b.block_rows(); ++v) {
+    const auto first = static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v)]);
+    const auto last = static_cast<std::size_t>(b.row_start[static_cast<std::size_t>(v) + 1]);
+    for (std::size_t k = first; k < last; ++k) {
+      const Eigen::Index column = 3 * static_cast<Eigen::Index>(b.column[k]);
+      for (std::size_t i = 0; i < 3; ++i)
+        for (std::size_t j = 0; j < 3; ++j)
+          entries.emplace_back(3 * v + static_cast<Eigen::Index>(i), column + static_cast<Eigen::Index>(j), b.values[9 * k + 3 * i + j]);
+    }
+  }
   a.setFromTriplets(entries.begin(), entries.end());
   a.makeCompressed();
   return a;
