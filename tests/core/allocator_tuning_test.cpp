@@ -19,8 +19,6 @@
 namespace cleave {
 namespace {
 
-constexpr bool kSanitizerAllocator = kAddressSanitizer;  // ASan brings its own allocator
-
 constexpr std::size_t kPageBytes = 4096;
 constexpr std::size_t kBlockBytes = std::size_t{256} << 20;  // well above glibc's 32 MB mapping threshold
 
@@ -51,7 +49,7 @@ long page_faults_of_a_reallocated_block(std::size_t bytes) {
 }
 
 TEST(AllocatorTuning, AFreedLargeBlockIsReusedWithoutPageFaults) {
-  if (kSanitizerAllocator) GTEST_SKIP() << "AddressSanitizer brings its own allocator";
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer brings its own allocator";
   const long untuned = page_faults_of_a_reallocated_block(kBlockBytes);
   if (untuned == 0) GTEST_SKIP() << "this C library already reuses freed large blocks";
   keep_freed_memory_for_reuse();
@@ -96,7 +94,7 @@ long faults_of_a_fresh_block_in_a_child(const std::string& environment) {
 // With the tunable restart_with_huge_pages sets (glibc.malloc.hugetlb=1) the heap comes in 2 MB
 // pages: touching a fresh 256 MB block takes a few hundred faults instead of one per 4 KB page.
 TEST(AllocatorTuning, HugePagesCutThePageFaultsOfAFreshBlock) {
-  if (kSanitizerAllocator) GTEST_SKIP() << "AddressSanitizer brings its own allocator";
+  if (kAddressSanitizer) GTEST_SKIP() << "AddressSanitizer brings its own allocator";
   std::ifstream thp("/sys/kernel/mm/transparent_hugepage/enabled");
   std::string modes;
   std::getline(thp, modes);

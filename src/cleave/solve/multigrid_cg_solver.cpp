@@ -50,9 +50,9 @@ class MultigridCgSolver final : public LinearSolver {
   }
 
   void update_values(const SparseMatrix& a, const LinkedVolume& topology) override {
-    const bool same_pattern = a.isCompressed() && a.rows() == rows_ && a.nonZeros() == pattern_nonzeros_ &&
-                              std::equal(pattern_row_start_.begin(), pattern_row_start_.end(), a.outerIndexPtr(),
-                                         a.outerIndexPtr() + a.rows() + 1);
+    // Compressed: the last row start is the entry count, so equal row starts mean equal sizes too.
+    const bool same_pattern = a.isCompressed() && std::equal(pattern_row_start_.begin(), pattern_row_start_.end(),
+                                                             a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1);
     if (!same_pattern || rebuild_requested_ || stale_updates_ >= options_.max_stale_updates) {
       setup(a, topology);
       return;
@@ -239,27 +239,23 @@ class MultigridCgSolver final : public LinearSolver {
   /// Drops the levels and the old matrix, then makes the block copy of `a` (compressed first when
   /// it is not) that the levels are built from.
   void take_blocks_of(const SparseMatrix& a) {
+    if (!a.isCompressed()) {
+      SparseMatrix compressed = a;
+      compressed.makeCompressed();
+      take_blocks_of(compressed);
+      return;
+    }
     preconditioner_ = MultigridPreconditioner();
     operator_ = nullptr;
     a_blocks_ = BlockSparseMatrix<double>();  // the old copy goes before the new one is made
-    if (a.isCompressed()) {
-      a_blocks_ = to_block_sparse<double>(a);
-      remember_pattern(a);
-    } else {
-      SparseMatrix compressed = a;
-      compressed.makeCompressed();
-      a_blocks_ = to_block_sparse<double>(compressed);
-      remember_pattern(compressed);
-    }
+    a_blocks_ = to_block_sparse<double>(a);
+    remember_pattern(a);
     rows_ = a.rows();
   }
 
-  /// The scalar pattern's row starts and size, against which update_values() checks that a new
+  /// The compressed scalar pattern's row starts, against which update_values() checks that a new
   /// matrix has the pattern the blocks were made from (the scalar matrix itself is not kept).
-  void remember_pattern(const SparseMatrix& a) {
-    pattern_row_start_.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1);
-    pattern_nonzeros_ = a.nonZeros();
-  }
+  void remember_pattern(const SparseMatrix& a) { pattern_row_start_.assign(a.outerIndexPtr(), a.outerIndexPtr() + a.rows() + 1); }
 
   /// Remembers the first solve's iterations after a build; a solve far above them asks for a
   /// rebuild at the next update.
@@ -275,7 +271,6 @@ class MultigridCgSolver final : public LinearSolver {
   const VertexOperator* operator_ = nullptr;  ///< ... unless the last update gave the matrix as an operator
   Eigen::Index rows_ = 0;  ///< of the current matrix (a_blocks_ is empty after a topology update by operator)
   std::vector<SparseMatrix::StorageIndex> pattern_row_start_;  ///< see remember_pattern()
-  Eigen::Index pattern_nonzeros_ = 0;
   MultigridPreconditioner preconditioner_;
   int stale_updates_ = 0;         ///< update_values() calls since the hierarchy was built
   int baseline_iterations_ = -1;  ///< iterations of the first solve after the build
