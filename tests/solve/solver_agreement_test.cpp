@@ -194,13 +194,15 @@ TEST(SolverAgreement, SingleAndDoublePrecisionCyclesAgree) {
 // residual goes on in single precision: the double cycle (twice the bytes per iteration, and a
 // double copy of every level) is for float rounding that stalls a round.
 TEST(SolverAgreement, ASlowButSteadyFloatCycleStaysInSinglePrecision) {
-  // A slender cantilever and the lightest smoothing: 56 iterations to 1e-10.
+  // A slender cantilever and the lightest smoothing: 56 iterations to 1e-10 (29 with its corner
+  // cells solved exactly as weak pieces, which are therefore off here).
   const TissueModel model = test::make_box({32, 8, 4}, 1.0);
   const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
   MultigridOptions options;
   options.coarsest_max_dofs = 30;
   options.smoother.degree = 1;
   options.coarse_degree = 1;
+  options.weak_pieces.max_links = 0;
   auto solver = make_multigrid_cg_solver(tight(), options);
   solver->setup(s.a, model.volume);
   Vector x = Vector::Zero(s.b.size());

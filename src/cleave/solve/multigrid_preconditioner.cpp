@@ -146,11 +146,15 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   }
   while (static_cast<int>(m.levels_.size()) < options.max_levels) {
     const std::size_t l = m.levels_.size() - 1;
-    const Eigen::Index rows = l == 0 ? a.rows() : m.levels_[l].matrix.rows();
-    if (rows <= options.coarsest_max_dofs) break;
+    // Free dofs only: held pieces (the removed plugs of round incisions) keep their replicas of
+    // coarse cells down to the coarsest level, but cost its factorization nothing.
+    const auto& fixed = m.levels_[l].fixed;
+    const auto free_dofs = static_cast<std::ptrdiff_t>(fixed.size()) - std::count(fixed.begin(), fixed.end(), std::uint8_t{1});
+    if (free_dofs <= options.coarsest_max_dofs) break;
     Coarsening next = coarsen_grid_level(grid);
     const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
     if (ratio > options.min_coarsening_ratio) break;
+    m.levels_[l].weak_pieces = find_weak_pieces(grid, options.weak_pieces);
     // Built in place: Eigen 3.4's SparseMatrix has no move, so assigning or moving one copies it.
     SparseMatrix galerkin = l == 0 ? galerkin_operator(a, m.levels_[l].fixed, next.prolongation)
                                    : galerkin_operator(m.levels_[l].matrix, m.levels_[l].fixed, next.prolongation);
@@ -167,6 +171,8 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     MultigridLevel& level = m.levels_[l];
     ChebyshevOptions smoother = options.smoother;
     if (l > 0) smoother.degree = options.coarse_degree;
+    if (l == 0) level.weak_pieces.factor(a, level.fixed);
+    else level.weak_pieces.factor(level.matrix, level.fixed);
     if (m.precision_ == CyclePrecision::single_precision) {
       level.single.blocks = l == 0 ? single_precision_copy(a) : to_block_sparse<float>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.single.blocks, smoother);
@@ -222,6 +228,7 @@ void MultigridPreconditioner::refresh_fine_level(const BlockSparseMatrix<double>
       a.blocks() != (precision_ == CyclePrecision::single_precision ? fine.single.blocks.blocks() : fine.twin.blocks.blocks()))
     throw InputError("multigrid: the refreshed matrix does not have the pattern the levels were built from");
   fine.smoother.set_inverse_diagonal(inverse_diagonal_blocks(a));
+  fine.weak_pieces.factor(a, fine.fixed);
   if (precision_ == CyclePrecision::double_precision) {
     fine.twin.blocks.values = a.values;
     return;
@@ -261,6 +268,7 @@ void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::v
   MultigridLevel& fine = levels_[0];
   fine_operator_ = &a;
   fine.fixed = a.fixed_dofs();
+  fine.weak_pieces = WeakPieceSolves();  // found on the old cells; the next rebuild finds the new ones
   fine.single.blocks = BlockSparseMatrix<float>();  // the old pattern: of no use to the new level
   fine.twin.blocks = BlockSparseMatrix<double>();
   if (precision_ == CyclePrecision::single_precision) {
@@ -278,6 +286,7 @@ void MultigridPreconditioner::replace_fine_level(const BlockSparseMatrix<double>
   MultigridLevel& fine = levels_[0];
   fine_operator_ = nullptr;
   fine.fixed = identity_rows(a);
+  fine.weak_pieces = WeakPieceSolves();  // found on the old cells; the next rebuild finds the new ones
   if (precision_ == CyclePrecision::single_precision) {
     fine.single.blocks = single_precision_copy(a);
     fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother);
@@ -323,12 +332,16 @@ template <typename Scalar, typename Matrix>
 void MultigridPreconditioner::smooth_around_coarse_correction(std::size_t l, const Matrix& a) const {
   const MultigridLevel& level = levels_[l];
   const CycleData<Scalar>& data = level.data<Scalar>();
+  // Weak pieces need the rows of A (block CSR); a fine level applied without its matrix has none.
+  constexpr bool kHasRows = std::is_same_v<Matrix, BlockSparseMatrix<Scalar>>;
   level.smoother.smooth_from_zero(a, data.rhs, data.solution, data.work);
+  if constexpr (kHasRows) level.weak_pieces.correct(a, data.rhs, data.solution, SweepOrder::forward);
   residual(a, data.rhs, data.solution, data.residual);
   const CycleData<Scalar>& coarse = levels_[l + 1].data<Scalar>();
   restrict_to_coarse(level.from_coarser, level.fixed, data.residual, coarse.rhs);
   cycle<Scalar>(l + 1);
   prolongate_add(level.from_coarser, level.fixed, coarse.solution, data.solution);
+  if constexpr (kHasRows) level.weak_pieces.correct(a, data.rhs, data.solution, SweepOrder::backward);
   level.smoother.smooth(a, data.rhs, data.solution, data.work);
 }
 

@@ -23,6 +23,7 @@
 #include "cleave/solve/chebyshev_smoother.hpp"
 #include "cleave/solve/coarsen_grid_level.hpp"
 #include "cleave/solve/conjugate_gradient.hpp"
+#include "cleave/solve/weak_piece_solves.hpp"
 
 namespace cleave {
 
@@ -34,7 +35,7 @@ enum class CyclePrecision {
 };
 
 struct MultigridOptions {
-  int coarsest_max_dofs = 2000;          ///< stop coarsening once a level is this small
+  int coarsest_max_dofs = 2000;          ///< stop coarsening once a level has this few free dofs
   double min_coarsening_ratio = 0.85;    ///< stop when a level keeps more than this share of dofs
   int max_levels = 12;
   ChebyshevOptions smoother;
@@ -61,6 +62,10 @@ struct MultigridOptions {
   /// it got: corotated free pieces (the studio's 108 removed plugs at 45k cells) made one stale
   /// solve take 1,426 iterations. 0: never rebuild mid-solve.
   double stale_solve_rebuild_factor = 3.0;
+  /// Exact solves on each level's weakly linked pieces (weak_piece_solves.hpp) before and after
+  /// the coarse correction: the incised tube's preview needs 15-16 iterations from 16k to 350k
+  /// cells with them, 18-50 without. weak_pieces.max_links = 0 turns them off.
+  WeakPieceOptions weak_pieces;
 };
 
 /// A level's operator and work vectors in the cycle's precision.
@@ -77,6 +82,7 @@ struct MultigridLevel {
   std::vector<std::uint8_t> fixed;  ///< per dof: identity row
   ChebyshevSmoother smoother;
   Prolongation from_coarser;        ///< empty on the coarsest level
+  WeakPieceSolves weak_pieces;      ///< empty on the coarsest level and where the level has none
   CycleData<float> single;          ///< filled when the cycle runs in single precision
   CycleData<double> twin;           ///< filled when it runs in double precision
 
@@ -111,7 +117,9 @@ class MultigridPreconditioner final : public Preconditioner {
   /// new values, same topology: fem/corotated_system_operator.hpp; referenced, it must outlive
   /// the use) and smooths with `a`'s block diagonal `inverse_diagonal`; the coarse levels, the
   /// smoothers' eigenvalue bounds and the coarsest factorization stay, as in refresh_fine_level.
-  /// refresh_fine_level and replace_fine_level go back to the fine level's blocks.
+  /// Such a fine level has no rows to solve its weak pieces with: it smooths without them (the
+  /// coarse levels keep theirs). refresh_fine_level and replace_fine_level go back to the fine
+  /// level's blocks.
   void use_fine_operator(const VertexOperator& a, std::vector<Mat3> inverse_diagonal);
   bool uses_fine_operator() const { return fine_operator_ != nullptr; }
 
@@ -120,7 +128,8 @@ class MultigridPreconditioner final : public Preconditioner {
   /// copy of the old fine vertex `origin_of_new[i]`. Each copy gets its origin's prolongation
   /// row; the fine level's fixed dofs, block diagonal and eigenvalue bound are those of `a`; the
   /// coarse levels and the coarsest factorization stay. Needs at least two levels (throws
-  /// InputError otherwise, and for origins or sizes that do not fit).
+  /// InputError otherwise, and for origins or sizes that do not fit). The fine level's weak
+  /// pieces were found on the old cells and are dropped until the next build.
   void replace_fine_level(const BlockSparseMatrix<double>& a, const std::vector<VertexId>& origin_of_new,
                           const ChebyshevOptions& smoother);
 

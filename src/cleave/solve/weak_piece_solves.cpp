@@ -1,0 +1,213 @@
+#include "cleave/solve/weak_piece_solves.hpp"
+
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
+#include <algorithm>
+
+#include "cleave/core/error.hpp"
+
+namespace cleave {
+namespace {
+
+/// Per cell: the cells it is linked to (each link seen from both sides).
+std::vector<std::vector<CellId>> linked_cells(const GridLevel& grid) {
+  std::vector<std::vector<CellId>> neighbours(static_cast<std::size_t>(grid.cell_count()));
+  for (const LevelLink& link : grid.links) {
+    neighbours[static_cast<std::size_t>(link.from)].push_back(link.to);
+    neighbours[static_cast<std::size_t>(link.to)].push_back(link.from);
+  }
+  return neighbours;
+}
+
+/// Position of `v` in the sorted `vertices`, or -1.
+int local_index(const std::vector<VertexId>& vertices, VertexId v) {
+  const auto it = std::lower_bound(vertices.begin(), vertices.end(), v);
+  return it != vertices.end() && *it == v ? static_cast<int>(it - vertices.begin()) : -1;
+}
+
+/// Greedy colouring of the pieces: two pieces touching a common cell (one's rows read the
+/// other's dofs) get different colours.
+void colour_pieces(const GridLevel& grid, const std::vector<int>& piece_start, const std::vector<VertexId>& vertex,
+                   std::vector<int>& colour_start, std::vector<int>& by_colour) {
+  const auto pieces = piece_start.size() - 1;
+  std::vector<std::vector<int>> pieces_of_vertex(static_cast<std::size_t>(grid.vertex_count));
+  for (std::size_t p = 0; p < pieces; ++p)
+    for (auto k = static_cast<std::size_t>(piece_start[p]); k < static_cast<std::size_t>(piece_start[p + 1]); ++k)
+      pieces_of_vertex[static_cast<std::size_t>(vertex[k])].push_back(static_cast<int>(p));
+  std::vector<std::vector<int>> conflicts(pieces);
+  std::vector<int> touching;
+  for (const auto& corners : grid.cell_vertices) {
+    touching.clear();
+    for (const VertexId v : corners)
+      for (const int p : pieces_of_vertex[static_cast<std::size_t>(v)]) touching.push_back(p);
+    std::sort(touching.begin(), touching.end());
+    touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
+    for (const int p : touching)
+      for (const int q : touching)
+        if (p != q) conflicts[static_cast<std::size_t>(p)].push_back(q);
+  }
+  std::vector<int> colour(pieces, -1);
+  int colours = 0;
+  std::vector<std::uint8_t> used;
+  for (std::size_t p = 0; p < pieces; ++p) {
+    used.assign(static_cast<std::size_t>(colours) + 1, 0);
+    for (const int q : conflicts[p])
+      if (colour[static_cast<std::size_t>(q)] >= 0) used[static_cast<std::size_t>(colour[static_cast<std::size_t>(q)])] = 1;
+    const auto first_free = std::find(used.begin(), used.end(), std::uint8_t{0}) - used.begin();
+    colour[p] = static_cast<int>(first_free);
+    colours = std::max(colours, colour[p] + 1);
+  }
+  colour_start.assign(static_cast<std::size_t>(colours) + 1, 0);
+  for (const int c : colour) ++colour_start[static_cast<std::size_t>(c) + 1];
+  for (std::size_t c = 0; c < static_cast<std::size_t>(colours); ++c) colour_start[c + 1] += colour_start[c];
+  by_colour.assign(pieces, 0);
+  std::vector<int> next(colour_start.begin(), colour_start.end() - 1);
+  for (std::size_t p = 0; p < pieces; ++p) by_colour[static_cast<std::size_t>(next[static_cast<std::size_t>(colour[p])]++)] = static_cast<int>(p);
+}
+
+}  // namespace
+
+WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& options) {
+  WeakPieceSolves pieces;
+  pieces.level_vertices_ = grid.vertex_count;
+  if (options.max_links <= 0 || options.max_cells <= 0) return pieces;
+  const auto cells = static_cast<std::size_t>(grid.cell_count());
+  const std::vector<std::vector<CellId>> neighbours = linked_cells(grid);
+  std::vector<std::uint8_t> weak(cells, 0);
+  for (std::size_t c = 0; c < cells; ++c) weak[c] = static_cast<int>(neighbours[c].size()) <= options.max_links ? 1 : 0;
+  std::vector<std::uint8_t> taken(cells, 0);
+  std::vector<CellId> queue;
+  std::vector<VertexId> vertices;
+  for (std::size_t seed = 0; seed < cells; ++seed) {
+    if (!weak[seed] || taken[seed]) continue;
+    // Breadth first over weak cells through links, until the piece is full.
+    queue.assign(1, static_cast<CellId>(seed));
+    taken[seed] = 1;
+    for (std::size_t head = 0; head < queue.size() && static_cast<int>(queue.size()) < options.max_cells; ++head)
+      for (const CellId next : neighbours[static_cast<std::size_t>(queue[head])]) {
+        const auto n = static_cast<std::size_t>(next);
+        if (!weak[n] || taken[n] || static_cast<int>(queue.size()) >= options.max_cells) continue;
+        taken[n] = 1;
+        queue.push_back(next);
+      }
+    vertices.clear();
+    for (const CellId c : queue)
+      for (const VertexId v : grid.cell_vertices[static_cast<std::size_t>(c)]) vertices.push_back(v);
+    std::sort(vertices.begin(), vertices.end());
+    vertices.erase(std::unique(vertices.begin(), vertices.end()), vertices.end());
+    pieces.vertex_.insert(pieces.vertex_.end(), vertices.begin(), vertices.end());
+    pieces.piece_start_.push_back(static_cast<int>(pieces.vertex_.size()));
+  }
+  colour_pieces(grid, pieces.piece_start_, pieces.vertex_, pieces.colour_start_, pieces.by_colour_);
+  return pieces;
+}
+
+std::vector<VertexId> WeakPieceSolves::piece_vertices(int p) const {
+  return {vertex_.begin() + piece_start_[static_cast<std::size_t>(p)], vertex_.begin() + piece_start_[static_cast<std::size_t>(p) + 1]};
+}
+
+template <typename RowVisitor>
+void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint8_t>& fixed, const RowVisitor& visit_row) {
+  if (rows != 3 * static_cast<Eigen::Index>(level_vertices_) || fixed.size() != static_cast<std::size_t>(rows))
+    throw InputError(fmt::format("weak pieces: matrix of {} rows and {} fixed flags for a level of {} vertices; expected {} each",
+                                 rows, fixed.size(), level_vertices_, 3 * static_cast<Eigen::Index>(level_vertices_)));
+  factors_.clear();
+  factor_of_piece_.assign(static_cast<std::size_t>(piece_count()), -1);
+  free_.clear();
+  for (int p = 0; p < piece_count(); ++p) {
+    const std::vector<VertexId> vertices = piece_vertices(p);
+    const auto n = static_cast<Eigen::Index>(3 * vertices.size());
+    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(n, n);
+    std::vector<std::uint8_t> free(static_cast<std::size_t>(n), 1);
+    for (std::size_t i = 0; i < vertices.size(); ++i)
+      visit_row(vertices[i], [&](VertexId column, const Mat3& value) {
+        const int j = local_index(vertices, column);
+        if (j >= 0) block.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * j) = value;
+      });
+    // Held dofs: identity rows and columns, so the piece's solve leaves them where they are.
+    for (Eigen::Index d = 0; d < n; ++d) {
+      const VertexId v = vertices[static_cast<std::size_t>(d / 3)];
+      if (!fixed[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(d % 3)]) continue;
+      free[static_cast<std::size_t>(d)] = 0;
+      block.row(d).setZero();
+      block.col(d).setZero();
+      block(d, d) = 1;
+    }
+    if (std::find(free.begin(), free.end(), std::uint8_t{1}) == free.end()) continue;  // a held piece (a removed plug)
+    Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
+    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 0)) continue;
+    factor_of_piece_[static_cast<std::size_t>(p)] = static_cast<int>(factors_.size());
+    factors_.push_back(std::move(ldlt));
+    free_.push_back(std::move(free));
+  }
+}
+
+void WeakPieceSolves::factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed) {
+  factor_rows(a.rows(), fixed, [&](VertexId row, const auto& take) {
+    const auto r = static_cast<std::size_t>(row);
+    for (auto k = static_cast<std::size_t>(a.row_start[r]); k < static_cast<std::size_t>(a.row_start[r + 1]); ++k)
+      take(a.column[k], Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * k));
+  });
+}
+
+void WeakPieceSolves::factor(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed) {
+  if (!a.isCompressed()) throw InputError("weak pieces: matrix must be compressed (makeCompressed)");
+  factor_rows(a.rows(), fixed, [&](VertexId row, const auto& take) {
+    // Gather the row's 3x3 blocks column vertex by column vertex (scalar CSR rows 3 v .. 3 v + 2).
+    std::vector<std::pair<VertexId, Mat3>> blocks;
+    for (int axis = 0; axis < 3; ++axis) {
+      const Eigen::Index i = 3 * static_cast<Eigen::Index>(row) + axis;
+      for (auto k = a.outerIndexPtr()[i]; k < a.outerIndexPtr()[i + 1]; ++k) {
+        const auto column = static_cast<VertexId>(a.innerIndexPtr()[k] / 3);
+        auto it = std::find_if(blocks.begin(), blocks.end(), [&](const auto& b) { return b.first == column; });
+        if (it == blocks.end()) it = blocks.insert(blocks.end(), {column, Mat3::Zero()});
+        it->second(axis, a.innerIndexPtr()[k] % 3) = a.valuePtr()[k];
+      }
+    }
+    for (const auto& [column, value] : blocks) take(column, value);
+  });
+}
+
+template <typename Scalar>
+void WeakPieceSolves::correct(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, SweepOrder order) const {
+  if (empty()) return;
+  const auto solve_piece = [&](std::size_t p) {
+    const int f = factor_of_piece_[p];
+    if (f < 0) return;
+    const auto first = static_cast<std::size_t>(piece_start_[p]), last = static_cast<std::size_t>(piece_start_[p + 1]);
+    const std::vector<std::uint8_t>& free = free_[static_cast<std::size_t>(f)];
+    Eigen::VectorXd residual(static_cast<Eigen::Index>(3 * (last - first)));
+    for (std::size_t i = first; i < last; ++i) {
+      const auto v = static_cast<std::size_t>(vertex_[i]);
+      Eigen::Matrix<Scalar, 3, 1> sum = b.template segment<3>(static_cast<Eigen::Index>(3 * v));
+      for (auto k = static_cast<std::size_t>(a.row_start[v]); k < static_cast<std::size_t>(a.row_start[v + 1]); ++k)
+        sum.noalias() -= Eigen::Map<const Eigen::Matrix<Scalar, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * k) *
+                         x.template segment<3>(3 * static_cast<Eigen::Index>(a.column[k]));
+      residual.segment<3>(static_cast<Eigen::Index>(3 * (i - first))) = sum.template cast<double>();
+    }
+    for (Eigen::Index d = 0; d < residual.size(); ++d)
+      if (!free[static_cast<std::size_t>(d)]) residual[d] = 0;
+    const Eigen::VectorXd step = factors_[static_cast<std::size_t>(f)].solve(residual);
+    for (std::size_t i = first; i < last; ++i)
+      for (int axis = 0; axis < 3; ++axis) {
+        const auto d = static_cast<Eigen::Index>(3 * (i - first)) + axis;
+        if (free[static_cast<std::size_t>(d)]) x[3 * static_cast<Eigen::Index>(vertex_[i]) + axis] += static_cast<Scalar>(step[d]);
+      }
+  };
+  const auto colours = colour_start_.size() - 1;
+  for (std::size_t step = 0; step < colours; ++step) {
+    const std::size_t c = order == SweepOrder::forward ? step : colours - 1 - step;
+    tbb::parallel_for(tbb::blocked_range<int>(colour_start_[c], colour_start_[c + 1], 8), [&](const tbb::blocked_range<int>& range) {
+      for (int k = range.begin(); k < range.end(); ++k) solve_piece(static_cast<std::size_t>(by_colour_[static_cast<std::size_t>(k)]));
+    });
+  }
+}
+
+template void WeakPieceSolves::correct<float>(const BlockSparseMatrix<float>&, const Eigen::VectorXf&, Eigen::VectorXf&, SweepOrder) const;
+template void WeakPieceSolves::correct<double>(const BlockSparseMatrix<double>&, const Eigen::VectorXd&, Eigen::VectorXd&,
+                                               SweepOrder) const;
+
+}  // namespace cleave

@@ -1,0 +1,85 @@
+#pragma once
+// Exact local solves on the weakly linked pieces of one multigrid level: cells held to the rest
+// by at most three uncut links (a column of cells left standing where a round incision meets the
+// body's edge, a sliver a cut leaves), grouped by their links. Such a piece is a thin beam or
+// hinge whose bending modes have almost no energy: the block-Jacobi Chebyshev smoother cannot
+// damp them (their eigenvalues of D^-1 A are tiny) and the trilinear coarse space cannot
+// represent them (the piece and the body it hangs on share a coarse cell). On the 44k-cell
+// incised tube one such column made the V-cycle's worst error mode (A-norm reduction 0.93 per
+// cycle); each piece's dofs are therefore solved exactly, Gauss-Seidel fashion over the pieces
+// (pieces that touch no common cell in parallel), between the smoother and the coarse correction.
+//
+//   WeakPieceSolves pieces = find_weak_pieces(grid, {});   // on the level's cells and links
+//   pieces.factor(a, fixed);                               // dense LDL^T of each piece's block
+//   pieces.correct(a, b, x, SweepOrder::forward);          // x += A_p^-1 (b - A x)_p per piece
+//   ...coarse correction...
+//   pieces.correct(a, b, x, SweepOrder::backward);         // the reverse sweep keeps the cycle symmetric
+//
+// A piece holds the free dofs of every vertex of its cells (those it shares with the body
+// included: a local Dirichlet problem). Pieces larger than `max_cells` are split, so a long
+// chain stays a row of small dense solves. A piece whose block is not positive definite (it
+// cannot be, for an SPD matrix, unless rounding hides a mechanism) is left out.
+#include <Eigen/Cholesky>
+#include <cstdint>
+#include <vector>
+
+#include "cleave/solve/block_sparse_matrix.hpp"
+#include "cleave/solve/grid_level.hpp"
+
+namespace cleave {
+
+struct WeakPieceOptions {
+  /// Cells with this many uncut links or fewer are weak (a cell inside a solid body has 6, on a
+  /// flat face 5, an edge 4, a corner 3). 0: no pieces. The preview's iterations on the incised
+  /// tube at 30 / 42 / 60 / 84 cells across: 18 / 29 / 37 / 50 without pieces, 16 / 16 / 18 / 27
+  /// with cells of at most 2 links, 15 / 15 / 16 / 16 with at most 3 (the uncut tube: 12).
+  int max_links = 3;
+  int max_cells = 24;  ///< cells per piece at most (dense solves of up to ~(4 max_cells + 4) x 3 dofs)
+};
+
+enum class SweepOrder { forward, backward };
+
+class WeakPieceSolves {
+ public:
+  /// True when there is nothing to solve (no pieces, or none factored yet).
+  bool empty() const { return factors_.empty(); }
+  int piece_count() const { return static_cast<int>(piece_start_.size()) - 1; }
+  int factored_count() const { return static_cast<int>(factors_.size()); }
+  /// Vertices of piece p (sorted).
+  std::vector<VertexId> piece_vertices(int p) const;
+
+  /// Factors each piece's block of `a` (its rows and columns; block CSR on the level's
+  /// vertices), with the dofs `fixed` flags as held. Throws InputError when `a` or `fixed` do
+  /// not have the level's size. Pieces whose block is not positive definite are dropped.
+  void factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed);
+  /// The same from compressed RowMajor scalar CSR (the coarse levels' Galerkin operators).
+  void factor(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed);
+
+  /// For each piece in turn: x_p += A_p^-1 (b - A x)_p on its free dofs, with the residual of
+  /// the piece's rows computed afresh (so a later piece sees what an earlier one moved).
+  template <typename Scalar>
+  void correct(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, SweepOrder order) const;
+
+ private:
+  friend WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& options);
+  template <typename RowVisitor>
+  void factor_rows(Eigen::Index rows, const std::vector<std::uint8_t>& fixed, const RowVisitor& visit_row);
+
+  VertexId level_vertices_ = 0;
+  std::vector<int> piece_start_{0};   ///< piece p's vertices: vertex_[piece_start_[p] .. piece_start_[p + 1])
+  std::vector<VertexId> vertex_;
+  /// Pieces by colour: no two pieces of one colour touch a common cell, so neither reads the
+  /// rows the other writes and a colour's pieces are solved in parallel.
+  std::vector<int> colour_start_{0};  ///< colour c's pieces: by_colour_[colour_start_[c] .. colour_start_[c + 1])
+  std::vector<int> by_colour_;
+  std::vector<int> factor_of_piece_;  ///< per piece: its index in factors_ and free_, -1 when left out
+  std::vector<Eigen::LDLT<Eigen::MatrixXd>> factors_;
+  std::vector<std::vector<std::uint8_t>> free_;  ///< per factor: per local dof, 1 = free
+};
+
+/// The weak cells of `grid` grouped by their uncut links into pieces of at most
+/// options.max_cells cells (breadth first from the piece's lowest cell). Not factored yet.
+WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& options);
+
+}  // namespace cleave
