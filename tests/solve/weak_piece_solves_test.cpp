@@ -58,6 +58,21 @@ TEST(WeakPieces, AreTheColumnsCellsSplitIntoPiecesOfAtMostMaxCells) {
   EXPECT_EQ(find_weak_pieces(grid, {.max_links = 0, .max_cells = 24}).piece_count(), 0);
 }
 
+// A cell with three links is weak when two of them are opposite (a column two cells wide: up,
+// down and its twin), not when it has one per axis (a box's corner: held in every direction).
+TEST(WeakPieces, ThreeLinksMakeACellWeakOnlyWithAnOppositePair) {
+  const TissueModel twin_columns = make_plate_with_columns({8, 6, 2}, 5, {Eigen::Vector2i(3, 2), Eigen::Vector2i(4, 2)}, 2.0);
+  const GridLevel grid = grid_level_of(twin_columns.volume);
+  const WeakPieceSolves tops = find_weak_pieces(grid, {.max_links = 2, .max_cells = 24});
+  ASSERT_EQ(tops.piece_count(), 1);  // the two top cells: down and the twin
+  EXPECT_EQ(tops.piece_vertices(0).size(), 12u);
+  const WeakPieceSolves pieces = find_weak_pieces(grid, {.max_links = 3, .max_cells = 24});
+  ASSERT_EQ(pieces.piece_count(), 1);
+  EXPECT_EQ(pieces.piece_vertices(0).size(), 6u * 6u);  // 2 x 5 cells: 6 layers of 6 corners
+  const TissueModel box = test::make_box({4, 4, 4}, 2.0);  // 8 corner cells of 3 links each
+  EXPECT_EQ(find_weak_pieces(grid_level_of(box.volume), {.max_links = 3, .max_cells = 24}).piece_count(), 0);
+}
+
 TEST(WeakPieces, ACorrectionSolvesThePiecesRowsExactlyAndLeavesHeldDofs) {
   const TissueModel model = make_plate_with_columns({6, 6, 2}, 5, {Eigen::Vector2i(3, 3)}, 2.0);
   const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);

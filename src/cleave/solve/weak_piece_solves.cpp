@@ -76,7 +76,17 @@ WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& 
   const auto cells = static_cast<std::size_t>(grid.cell_count());
   const std::vector<std::vector<CellId>> neighbours = linked_cells(grid);
   std::vector<std::uint8_t> weak(cells, 0);
-  for (std::size_t c = 0; c < cells; ++c) weak[c] = static_cast<int>(neighbours[c].size()) <= options.max_links ? 1 : 0;
+  std::vector<std::uint8_t> faces(cells, 0);
+  for (const LevelLink& link : grid.links) {
+    faces[static_cast<std::size_t>(link.from)] |= static_cast<std::uint8_t>(1u << link.face);
+    faces[static_cast<std::size_t>(link.to)] |= static_cast<std::uint8_t>(1u << opposite(link.face));
+  }
+  for (std::size_t c = 0; c < cells; ++c) {
+    const int links = static_cast<int>(neighbours[c].size());
+    const std::uint8_t f = faces[c];
+    const bool opposite_pair = (f & 0b000011u) == 0b000011u || (f & 0b001100u) == 0b001100u || (f & 0b110000u) == 0b110000u;
+    weak[c] = links <= options.max_links && (links <= 2 || opposite_pair) ? 1 : 0;
+  }
   std::vector<std::uint8_t> taken(cells, 0);
   std::vector<CellId> queue;
   std::vector<VertexId> vertices;
@@ -113,35 +123,57 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
   if (rows != 3 * static_cast<Eigen::Index>(level_vertices_) || fixed.size() != static_cast<std::size_t>(rows))
     throw InputError(fmt::format("weak pieces: matrix of {} rows and {} fixed flags for a level of {} vertices; expected {} each",
                                  rows, fixed.size(), level_vertices_, 3 * static_cast<Eigen::Index>(level_vertices_)));
-  factors_.clear();
-  factor_of_piece_.assign(static_cast<std::size_t>(piece_count()), -1);
-  free_.clear();
-  for (int p = 0; p < piece_count(); ++p) {
-    const std::vector<VertexId> vertices = piece_vertices(p);
-    const auto n = static_cast<Eigen::Index>(3 * vertices.size());
-    Eigen::MatrixXd block = Eigen::MatrixXd::Zero(n, n);
-    std::vector<std::uint8_t> free(static_cast<std::size_t>(n), 1);
-    for (std::size_t i = 0; i < vertices.size(); ++i)
-      visit_row(vertices[i], [&](VertexId column, const Mat3& value) {
-        const int j = local_index(vertices, column);
-        if (j >= 0) block.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * j) = value;
-      });
-    // Held dofs: identity rows and columns, so the piece's solve leaves them where they are.
-    for (Eigen::Index d = 0; d < n; ++d) {
-      const VertexId v = vertices[static_cast<std::size_t>(d / 3)];
-      if (!fixed[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(d % 3)]) continue;
-      free[static_cast<std::size_t>(d)] = 0;
-      block.row(d).setZero();
-      block.col(d).setZero();
-      block(d, d) = 1;
-    }
-    if (std::find(free.begin(), free.end(), std::uint8_t{1}) == free.end()) continue;  // a held piece (a removed plug)
-    Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
-    if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 0)) continue;
-    factor_of_piece_[static_cast<std::size_t>(p)] = static_cast<int>(factors_.size());
-    factors_.push_back(std::move(ldlt));
-    free_.push_back(std::move(free));
+  // Room for the inverse of every piece with a free dof (a piece of held dofs only, a removed
+  // plug, has nothing to solve), then the pieces in parallel, each into its own place.
+  const auto pieces = static_cast<std::size_t>(piece_count());
+  inverse_start_.assign(pieces, -1);
+  std::int64_t size = 0;
+  for (std::size_t p = 0; p < pieces; ++p) {
+    const auto first = static_cast<std::size_t>(piece_start_[p]), last = static_cast<std::size_t>(piece_start_[p + 1]);
+    bool any_free = false;
+    for (std::size_t i = first; i < last && !any_free; ++i)
+      for (std::size_t axis = 0; axis < 3; ++axis) any_free = any_free || !fixed[3 * static_cast<std::size_t>(vertex_[i]) + axis];
+    if (!any_free) continue;
+    inverse_start_[p] = size;
+    size += 9 * static_cast<std::int64_t>((last - first) * (last - first));
   }
+  inverse_.assign(static_cast<std::size_t>(size), 0.0);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces, 4), [&](const tbb::blocked_range<std::size_t>& range) {
+    for (std::size_t p = range.begin(); p < range.end(); ++p) {
+      if (inverse_start_[p] < 0) continue;
+      const std::vector<VertexId> vertices = piece_vertices(static_cast<int>(p));
+      const auto n = static_cast<Eigen::Index>(3 * vertices.size());
+      Eigen::MatrixXd block = Eigen::MatrixXd::Zero(n, n);
+      for (std::size_t i = 0; i < vertices.size(); ++i)
+        visit_row(vertices[i], [&](VertexId column, const Mat3& value) {
+          const int j = local_index(vertices, column);
+          if (j >= 0) block.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * j) = value;
+        });
+      // Held dofs: identity rows and columns for the factorization, zero in the inverse, so the
+      // piece's solve leaves them where they are.
+      std::vector<Eigen::Index> held;
+      for (Eigen::Index d = 0; d < n; ++d) {
+        const VertexId v = vertices[static_cast<std::size_t>(d / 3)];
+        if (!fixed[3 * static_cast<std::size_t>(v) + static_cast<std::size_t>(d % 3)]) continue;
+        held.push_back(d);
+        block.row(d).setZero();
+        block.col(d).setZero();
+        block(d, d) = 1;
+      }
+      const Eigen::LDLT<Eigen::MatrixXd> ldlt(block);
+      if (ldlt.info() != Eigen::Success || !ldlt.isPositive() || !(ldlt.vectorD().minCoeff() > 0)) {
+        inverse_start_[p] = -1;  // its room stays unused
+        continue;
+      }
+      Eigen::Map<Eigen::MatrixXd> inverse(inverse_.data() + inverse_start_[p], n, n);
+      inverse = ldlt.solve(Eigen::MatrixXd::Identity(n, n));
+      for (const Eigen::Index d : held) {
+        inverse.row(d).setZero();
+        inverse.col(d).setZero();
+      }
+    }
+  });
+  factored_ = static_cast<int>(std::count_if(inverse_start_.begin(), inverse_start_.end(), [](std::int64_t start) { return start >= 0; }));
 }
 
 void WeakPieceSolves::factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed) {
@@ -174,12 +206,11 @@ template <typename Scalar>
 void WeakPieceSolves::correct(const BlockSparseMatrix<Scalar>& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
                               Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, SweepOrder order) const {
   if (empty()) return;
-  const auto solve_piece = [&](std::size_t p) {
-    const int f = factor_of_piece_[p];
-    if (f < 0) return;
+  const auto solve_piece = [&](std::size_t p, Eigen::VectorXd& residual, Eigen::VectorXd& step) {
+    if (inverse_start_[p] < 0) return;
     const auto first = static_cast<std::size_t>(piece_start_[p]), last = static_cast<std::size_t>(piece_start_[p + 1]);
-    const std::vector<std::uint8_t>& free = free_[static_cast<std::size_t>(f)];
-    Eigen::VectorXd residual(static_cast<Eigen::Index>(3 * (last - first)));
+    const auto n = static_cast<Eigen::Index>(3 * (last - first));
+    residual.resize(n);
     for (std::size_t i = first; i < last; ++i) {
       const auto v = static_cast<std::size_t>(vertex_[i]);
       Eigen::Matrix<Scalar, 3, 1> sum = b.template segment<3>(static_cast<Eigen::Index>(3 * v));
@@ -188,20 +219,18 @@ void WeakPieceSolves::correct(const BlockSparseMatrix<Scalar>& a, const Eigen::M
                          x.template segment<3>(3 * static_cast<Eigen::Index>(a.column[k]));
       residual.segment<3>(static_cast<Eigen::Index>(3 * (i - first))) = sum.template cast<double>();
     }
-    for (Eigen::Index d = 0; d < residual.size(); ++d)
-      if (!free[static_cast<std::size_t>(d)]) residual[d] = 0;
-    const Eigen::VectorXd step = factors_[static_cast<std::size_t>(f)].solve(residual);
+    step.noalias() = Eigen::Map<const Eigen::MatrixXd>(inverse_.data() + inverse_start_[p], n, n) * residual;  // held dofs: 0
     for (std::size_t i = first; i < last; ++i)
-      for (int axis = 0; axis < 3; ++axis) {
-        const auto d = static_cast<Eigen::Index>(3 * (i - first)) + axis;
-        if (free[static_cast<std::size_t>(d)]) x[3 * static_cast<Eigen::Index>(vertex_[i]) + axis] += static_cast<Scalar>(step[d]);
-      }
+      x.template segment<3>(3 * static_cast<Eigen::Index>(vertex_[i])) +=
+          step.segment<3>(static_cast<Eigen::Index>(3 * (i - first))).template cast<Scalar>();
   };
   const auto colours = colour_start_.size() - 1;
-  for (std::size_t step = 0; step < colours; ++step) {
-    const std::size_t c = order == SweepOrder::forward ? step : colours - 1 - step;
-    tbb::parallel_for(tbb::blocked_range<int>(colour_start_[c], colour_start_[c + 1], 8), [&](const tbb::blocked_range<int>& range) {
-      for (int k = range.begin(); k < range.end(); ++k) solve_piece(static_cast<std::size_t>(by_colour_[static_cast<std::size_t>(k)]));
+  for (std::size_t s = 0; s < colours; ++s) {
+    const std::size_t c = order == SweepOrder::forward ? s : colours - 1 - s;
+    tbb::parallel_for(tbb::blocked_range<int>(colour_start_[c], colour_start_[c + 1], 16), [&](const tbb::blocked_range<int>& range) {
+      Eigen::VectorXd residual, step;  // per task, reused across its pieces
+      for (int k = range.begin(); k < range.end(); ++k)
+        solve_piece(static_cast<std::size_t>(by_colour_[static_cast<std::size_t>(k)]), residual, step);
     });
   }
 }

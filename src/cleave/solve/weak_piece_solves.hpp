@@ -1,7 +1,7 @@
 #pragma once
 // Exact local solves on the weakly linked pieces of one multigrid level: cells held to the rest
-// by at most three uncut links (a column of cells left standing where a round incision meets the
-// body's edge, a sliver a cut leaves), grouped by their links. Such a piece is a thin beam or
+// by at most two uncut links, or three of which two are opposite (a column of cells left standing
+// where a round incision meets the body's edge, a sliver a cut leaves), grouped by their links. Such a piece is a thin beam or
 // hinge whose bending modes have almost no energy: the block-Jacobi Chebyshev smoother cannot
 // damp them (their eigenvalues of D^-1 A are tiny) and the trilinear coarse space cannot
 // represent them (the piece and the body it hangs on share a coarse cell). On the 44k-cell
@@ -10,7 +10,7 @@
 // (pieces that touch no common cell in parallel), between the smoother and the coarse correction.
 //
 //   WeakPieceSolves pieces = find_weak_pieces(grid, {});   // on the level's cells and links
-//   pieces.factor(a, fixed);                               // dense LDL^T of each piece's block
+//   pieces.factor(a, fixed);                               // the inverse of each piece's block
 //   pieces.correct(a, b, x, SweepOrder::forward);          // x += A_p^-1 (b - A x)_p per piece
 //   ...coarse correction...
 //   pieces.correct(a, b, x, SweepOrder::backward);         // the reverse sweep keeps the cycle symmetric
@@ -30,11 +30,19 @@ namespace cleave {
 
 struct WeakPieceOptions {
   /// Cells with this many uncut links or fewer are weak (a cell inside a solid body has 6, on a
-  /// flat face 5, an edge 4, a corner 3). 0: no pieces. The preview's iterations on the incised
-  /// tube at 30 / 42 / 60 / 84 cells across: 18 / 29 / 37 / 50 without pieces, 16 / 16 / 18 / 27
-  /// with cells of at most 2 links, 15 / 15 / 16 / 16 with at most 3 (the uncut tube: 12).
+  /// flat face 5, an edge 4, a corner 3), except that a cell with three links is weak only when
+  /// two of them are opposite (a cell of a column or ledge two cells wide), not when it has one
+  /// per axis (a corner of a staircase surface: held in every direction). 0: no pieces.
+  /// The preview's iterations on the incised tube at 42 / 60 / 84 cells across: 29 / 37 / 50
+  /// without pieces; 16 / 18 / 27 with the cells of at most 2 links; 15 / 17 / 17 with this rule
+  /// (124 / 120 / 184 pieces on the fine level); 15 / 16 / 16 with every cell of 3 links (569 /
+  /// 908 / 1470 pieces, and 2,920 on the incised abdomen-126 whose staircase shell gains nothing
+  /// from them: 31 iterations against 32, at 1.4-1.8x the time). The uncut tube needs 12.
   int max_links = 3;
-  int max_cells = 24;  ///< cells per piece at most (dense solves of up to ~(4 max_cells + 4) x 3 dofs)
+  /// Cells per piece at most: its inverse has (3 x its vertices)^2 entries, read at every sweep.
+  /// 8 and 24 give the same iterations on the incised tube; 8 keeps the inverses 30 % smaller on
+  /// the incised abdomen (7 MB against 10 MB at 45k cells).
+  int max_cells = 8;
 };
 
 enum class SweepOrder { forward, backward };
@@ -42,15 +50,24 @@ enum class SweepOrder { forward, backward };
 class WeakPieceSolves {
  public:
   /// True when there is nothing to solve (no pieces, or none factored yet).
-  bool empty() const { return factors_.empty(); }
+  bool empty() const { return factored_ == 0; }
   int piece_count() const { return static_cast<int>(piece_start_.size()) - 1; }
-  int factored_count() const { return static_cast<int>(factors_.size()); }
+  int factored_count() const { return factored_; }
+  /// Bytes of the pieces' inverses.
+  std::size_t inverse_bytes() const { return inverse_.size() * sizeof(double); }
   /// Vertices of piece p (sorted).
   std::vector<VertexId> piece_vertices(int p) const;
+  /// Colours of the parallel sweep: the pieces of one colour touch no common cell.
+  int colour_count() const { return static_cast<int>(colour_start_.size()) - 1; }
+  std::vector<int> colour_pieces(int c) const {
+    return {by_colour_.begin() + colour_start_[static_cast<std::size_t>(c)], by_colour_.begin() + colour_start_[static_cast<std::size_t>(c) + 1]};
+  }
 
-  /// Factors each piece's block of `a` (its rows and columns; block CSR on the level's
-  /// vertices), with the dofs `fixed` flags as held. Throws InputError when `a` or `fixed` do
-  /// not have the level's size. Pieces whose block is not positive definite are dropped.
+  /// Inverts each piece's block of `a` (its rows and columns; block CSR on the level's vertices;
+  /// by LDL^T, kept as the explicit inverse: pieces are small, and one dense product per solve
+  /// is faster than two triangular solves), with the dofs `fixed` flags as held. Throws
+  /// InputError when `a` or `fixed` do not have the level's size. Pieces whose block is not
+  /// positive definite are dropped.
   void factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed);
   /// The same from compressed RowMajor scalar CSR (the coarse levels' Galerkin operators).
   void factor(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed);
@@ -73,9 +90,11 @@ class WeakPieceSolves {
   /// rows the other writes and a colour's pieces are solved in parallel.
   std::vector<int> colour_start_{0};  ///< colour c's pieces: by_colour_[colour_start_[c] .. colour_start_[c + 1])
   std::vector<int> by_colour_;
-  std::vector<int> factor_of_piece_;  ///< per piece: its index in factors_ and free_, -1 when left out
-  std::vector<Eigen::LDLT<Eigen::MatrixXd>> factors_;
-  std::vector<std::vector<std::uint8_t>> free_;  ///< per factor: per local dof, 1 = free
+  /// Per piece: where its inverse starts in inverse_ (an n x n column-major block, n = 3 x its
+  /// vertices, rows and columns of held dofs zero), -1 when left out.
+  std::vector<std::int64_t> inverse_start_;
+  std::vector<double> inverse_;
+  int factored_ = 0;
 };
 
 /// The weak cells of `grid` grouped by their uncut links into pieces of at most
