@@ -109,6 +109,38 @@ TEST(WeakPieces, ACorrectionSolvesThePiecesRowsExactlyAndLeavesHeldDofs) {
   EXPECT_LT((xf.cast<double>() - x).lpNorm<Eigen::Infinity>(), 1e-4 * x.lpNorm<Eigen::Infinity>());
 }
 
+// Pieces of one colour are solved in parallel: none may read (a column of its rows) a dof that
+// another of its colour writes (its own vertices). Columns two cells apart read each other
+// through the plate cells under them; four apart they do not.
+TEST(WeakPieces, NoPieceOfAColourReadsWhatAnotherOfItWrites) {
+  std::vector<Eigen::Vector2i> columns;
+  for (int x = 1; x < 15; x += 2) columns.push_back(Eigen::Vector2i(x, 2));
+  for (int x = 1; x < 15; x += 4) columns.push_back(Eigen::Vector2i(x, 6));
+  const TissueModel model = make_plate_with_columns({16, 8, 2}, 4, columns, 2.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  const BlockSparseMatrix<double> a = to_block_sparse<double>(s.a);
+  WeakPieceSolves pieces = find_weak_pieces(grid_level_of(model.volume), {});
+  pieces.factor(a, identity_rows(a));
+  ASSERT_EQ(pieces.piece_count(), static_cast<int>(columns.size()));
+  ASSERT_GE(pieces.colour_count(), 2);
+  int checked_pairs = 0;
+  for (int c = 0; c < pieces.colour_count(); ++c) {
+    const std::vector<int> members = pieces.colour_pieces(c);
+    for (const int p : members)
+      for (const int q : members) {
+        if (p == q) continue;
+        const std::vector<VertexId> writes = pieces.piece_vertices(q);
+        for (const VertexId v : pieces.piece_vertices(p))
+          for (auto k = a.row_start[static_cast<std::size_t>(v)]; k < a.row_start[static_cast<std::size_t>(v) + 1]; ++k) {
+            EXPECT_FALSE(std::binary_search(writes.begin(), writes.end(), a.column[static_cast<std::size_t>(k)]))
+                << "pieces " << p << " and " << q << " of colour " << c;
+          }
+        ++checked_pairs;
+      }
+  }
+  EXPECT_GT(checked_pairs, 0);
+}
+
 TEST(WeakPieces, RefuseAMatrixOfAnotherLevel) {
   const TissueModel model = make_plate_with_columns({4, 4, 2}, 3, {Eigen::Vector2i(1, 1)}, 2.0);
   WeakPieceSolves pieces = find_weak_pieces(grid_level_of(model.volume), {});

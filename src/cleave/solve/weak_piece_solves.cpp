@@ -27,27 +27,24 @@ int local_index(const std::vector<VertexId>& vertices, VertexId v) {
   return it != vertices.end() && *it == v ? static_cast<int>(it - vertices.begin()) : -1;
 }
 
-/// Greedy colouring of the pieces: two pieces touching a common cell (one's rows read the
-/// other's dofs) get different colours.
-void colour_pieces(const GridLevel& grid, const std::vector<int>& piece_start, const std::vector<VertexId>& vertex,
-                   std::vector<int>& colour_start, std::vector<int>& by_colour) {
+/// Greedy colouring of the pieces: piece p conflicts with piece q when one of p's rows reads a
+/// dof q writes (`reads[p]`: the column vertices of p's rows; q writes its own vertices). Pieces
+/// of one colour can then be solved at the same time.
+void colour_by_conflicts(VertexId vertex_count, const std::vector<int>& piece_start, const std::vector<VertexId>& vertex,
+                   const std::vector<std::vector<VertexId>>& reads, std::vector<int>& colour_start, std::vector<int>& by_colour) {
   const auto pieces = piece_start.size() - 1;
-  std::vector<std::vector<int>> pieces_of_vertex(static_cast<std::size_t>(grid.vertex_count));
+  std::vector<std::vector<int>> writers(static_cast<std::size_t>(vertex_count));
   for (std::size_t p = 0; p < pieces; ++p)
     for (auto k = static_cast<std::size_t>(piece_start[p]); k < static_cast<std::size_t>(piece_start[p + 1]); ++k)
-      pieces_of_vertex[static_cast<std::size_t>(vertex[k])].push_back(static_cast<int>(p));
+      writers[static_cast<std::size_t>(vertex[k])].push_back(static_cast<int>(p));
   std::vector<std::vector<int>> conflicts(pieces);
-  std::vector<int> touching;
-  for (const auto& corners : grid.cell_vertices) {
-    touching.clear();
-    for (const VertexId v : corners)
-      for (const int p : pieces_of_vertex[static_cast<std::size_t>(v)]) touching.push_back(p);
-    std::sort(touching.begin(), touching.end());
-    touching.erase(std::unique(touching.begin(), touching.end()), touching.end());
-    for (const int p : touching)
-      for (const int q : touching)
-        if (p != q) conflicts[static_cast<std::size_t>(p)].push_back(q);
-  }
+  for (std::size_t p = 0; p < pieces; ++p)
+    for (const VertexId v : reads[p])
+      for (const int q : writers[static_cast<std::size_t>(v)])
+        if (q != static_cast<int>(p)) {
+          conflicts[p].push_back(q);
+          conflicts[static_cast<std::size_t>(q)].push_back(static_cast<int>(p));
+        }
   std::vector<int> colour(pieces, -1);
   int colours = 0;
   std::vector<std::uint8_t> used;
@@ -110,7 +107,6 @@ WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& 
     pieces.vertex_.insert(pieces.vertex_.end(), vertices.begin(), vertices.end());
     pieces.piece_start_.push_back(static_cast<int>(pieces.vertex_.size()));
   }
-  colour_pieces(grid, pieces.piece_start_, pieces.vertex_, pieces.colour_start_, pieces.by_colour_);
   return pieces;
 }
 
@@ -128,8 +124,12 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
   const auto pieces = static_cast<std::size_t>(piece_count());
   inverse_start_.assign(pieces, -1);
   std::int64_t size = 0;
+  std::vector<std::vector<VertexId>> reads(pieces);  // the column vertices of each piece's rows
   for (std::size_t p = 0; p < pieces; ++p) {
     const auto first = static_cast<std::size_t>(piece_start_[p]), last = static_cast<std::size_t>(piece_start_[p + 1]);
+    for (std::size_t i = first; i < last; ++i) visit_row(vertex_[i], [&](VertexId column, const Mat3&) { reads[p].push_back(column); });
+    std::sort(reads[p].begin(), reads[p].end());
+    reads[p].erase(std::unique(reads[p].begin(), reads[p].end()), reads[p].end());
     bool any_free = false;
     for (std::size_t i = first; i < last && !any_free; ++i)
       for (std::size_t axis = 0; axis < 3; ++axis) any_free = any_free || !fixed[3 * static_cast<std::size_t>(vertex_[i]) + axis];
@@ -137,6 +137,7 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
     inverse_start_[p] = size;
     size += 9 * static_cast<std::int64_t>((last - first) * (last - first));
   }
+  colour_by_conflicts(level_vertices_, piece_start_, vertex_, reads, colour_start_, by_colour_);
   inverse_.assign(static_cast<std::size_t>(size), 0.0);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, pieces, 4), [&](const tbb::blocked_range<std::size_t>& range) {
     for (std::size_t p = range.begin(); p < range.end(); ++p) {

@@ -1,13 +1,14 @@
 #pragma once
 // Exact local solves on the weakly linked pieces of one multigrid level: cells held to the rest
 // by at most two uncut links, or three of which two are opposite (a column of cells left standing
-// where a round incision meets the body's edge, a sliver a cut leaves), grouped by their links. Such a piece is a thin beam or
-// hinge whose bending modes have almost no energy: the block-Jacobi Chebyshev smoother cannot
-// damp them (their eigenvalues of D^-1 A are tiny) and the trilinear coarse space cannot
-// represent them (the piece and the body it hangs on share a coarse cell). On the 44k-cell
+// where a round incision meets the body's edge, a sliver a cut leaves), grouped by their links.
+// Such a piece is a thin beam or hinge whose bending modes have almost no energy: the
+// block-Jacobi Chebyshev smoother cannot damp them (their eigenvalues of D^-1 A are tiny) and the
+// trilinear coarse space cannot represent them (the piece and the body it hangs on share a coarse cell). On the 44k-cell
 // incised tube one such column made the V-cycle's worst error mode (A-norm reduction 0.93 per
 // cycle); each piece's dofs are therefore solved exactly, Gauss-Seidel fashion over the pieces
-// (pieces that touch no common cell in parallel), between the smoother and the coarse correction.
+// (pieces that do not read each other's dofs in parallel), between the smoother and the coarse
+// correction.
 //
 //   WeakPieceSolves pieces = find_weak_pieces(grid, {});   // on the level's cells and links
 //   pieces.factor(a, fixed);                               // the inverse of each piece's block
@@ -57,7 +58,8 @@ class WeakPieceSolves {
   std::size_t inverse_bytes() const { return inverse_.size() * sizeof(double); }
   /// Vertices of piece p (sorted).
   std::vector<VertexId> piece_vertices(int p) const;
-  /// Colours of the parallel sweep: the pieces of one colour touch no common cell.
+  /// Colours of the parallel sweep (set by factor): no piece of a colour reads a dof (a column of
+  /// its rows) that another piece of the colour writes (its own vertices).
   int colour_count() const { return static_cast<int>(colour_start_.size()) - 1; }
   std::vector<int> colour_pieces(int c) const {
     return {by_colour_.begin() + colour_start_[static_cast<std::size_t>(c)], by_colour_.begin() + colour_start_[static_cast<std::size_t>(c) + 1]};
@@ -86,8 +88,8 @@ class WeakPieceSolves {
   VertexId level_vertices_ = 0;
   std::vector<int> piece_start_{0};   ///< piece p's vertices: vertex_[piece_start_[p] .. piece_start_[p + 1])
   std::vector<VertexId> vertex_;
-  /// Pieces by colour: no two pieces of one colour touch a common cell, so neither reads the
-  /// rows the other writes and a colour's pieces are solved in parallel.
+  /// Pieces by colour (from the matrix's pattern at factor): no piece of a colour reads what
+  /// another writes, so a colour's pieces are solved in parallel.
   std::vector<int> colour_start_{0};  ///< colour c's pieces: by_colour_[colour_start_[c] .. colour_start_[c + 1])
   std::vector<int> by_colour_;
   /// Per piece: where its inverse starts in inverse_ (an n x n column-major block, n = 3 x its
