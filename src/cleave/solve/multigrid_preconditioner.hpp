@@ -63,8 +63,8 @@ struct MultigridOptions {
   /// solve take 1,426 iterations. 0: never rebuild mid-solve.
   double stale_solve_rebuild_factor = 3.0;
   /// Exact solves on each level's weakly linked pieces (weak_piece_solves.hpp) before and after
-  /// the coarse correction: the incised tube's preview needs 15-16 iterations from 16k to 350k
-  /// cells with them, 18-50 without. weak_pieces.max_links = 0 turns them off.
+  /// the coarse correction: the incised tube's preview needs 15-17 iterations from 44k to 350k
+  /// cells with them, 29-50 without. weak_pieces.max_links = 0 turns them off.
   WeakPieceOptions weak_pieces;
 };
 
