@@ -146,7 +146,7 @@ TEST(WeakPieces, RefuseAMatrixOfAnotherLevel) {
   WeakPieceSolves pieces = find_weak_pieces(grid_level_of(model.volume), {});
   const SparseMatrix a = assemble_stiffness(test::make_box({2, 2, 2}, 2.0));
   try {
-    pieces.factor(a, std::vector<std::uint8_t>(static_cast<std::size_t>(a.rows()), 0));
+    pieces.factor(to_block_sparse<double>(a), std::vector<std::uint8_t>(static_cast<std::size_t>(a.rows()), 0));
     FAIL() << "expected InputError";
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "weak pieces: matrix of 81 rows and 81 fixed flags for a level of 87 vertices; expected 261 each");

@@ -171,8 +171,6 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     MultigridLevel& level = m.levels_[l];
     ChebyshevOptions smoother = options.smoother;
     if (l > 0) smoother.degree = options.coarse_degree;
-    if (l == 0) level.weak_pieces.factor(a, level.fixed);
-    else level.weak_pieces.factor(level.matrix, level.fixed);
     if (m.precision_ == CyclePrecision::single_precision) {
       level.single.blocks = l == 0 ? single_precision_copy(a) : to_block_sparse<float>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.single.blocks, smoother);
@@ -180,6 +178,11 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
       level.twin.blocks = l == 0 ? a : to_block_sparse<double>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.twin.blocks, smoother);
     }
+    // The pieces are inverted in double: from the fine matrix, the double cycle's blocks, or (a
+    // float cycle's coarse level with pieces) a double block copy made for it.
+    if (l == 0) level.weak_pieces.factor(a, level.fixed);
+    else if (m.precision_ == CyclePrecision::double_precision) level.weak_pieces.factor(level.twin.blocks, level.fixed);
+    else if (level.weak_pieces.piece_count() > 0) level.weak_pieces.factor(to_block_sparse<double>(level.matrix), level.fixed);
   }
 
   m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();

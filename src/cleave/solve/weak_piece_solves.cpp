@@ -114,11 +114,14 @@ std::vector<VertexId> WeakPieceSolves::piece_vertices(int p) const {
   return {vertex_.begin() + piece_start_[static_cast<std::size_t>(p)], vertex_.begin() + piece_start_[static_cast<std::size_t>(p) + 1]};
 }
 
-template <typename RowVisitor>
-void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint8_t>& fixed, const RowVisitor& visit_row) {
-  if (rows != 3 * static_cast<Eigen::Index>(level_vertices_) || fixed.size() != static_cast<std::size_t>(rows))
+void WeakPieceSolves::factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed) {
+  if (a.rows() != 3 * static_cast<Eigen::Index>(level_vertices_) || fixed.size() != static_cast<std::size_t>(a.rows()))
     throw InputError(fmt::format("weak pieces: matrix of {} rows and {} fixed flags for a level of {} vertices; expected {} each",
-                                 rows, fixed.size(), level_vertices_, 3 * static_cast<Eigen::Index>(level_vertices_)));
+                                 a.rows(), fixed.size(), level_vertices_, 3 * static_cast<Eigen::Index>(level_vertices_)));
+  const auto row_blocks = [&](VertexId v) {
+    return std::pair{static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v)]),
+                     static_cast<std::size_t>(a.row_start[static_cast<std::size_t>(v) + 1])};
+  };
   // Room for the inverse of every piece with a free dof (a piece of held dofs only, a removed
   // plug, has nothing to solve), then the pieces in parallel, each into its own place.
   const auto pieces = static_cast<std::size_t>(piece_count());
@@ -127,7 +130,10 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
   std::vector<std::vector<VertexId>> reads(pieces);  // the column vertices of each piece's rows
   for (std::size_t p = 0; p < pieces; ++p) {
     const auto first = static_cast<std::size_t>(piece_start_[p]), last = static_cast<std::size_t>(piece_start_[p + 1]);
-    for (std::size_t i = first; i < last; ++i) visit_row(vertex_[i], [&](VertexId column, const Mat3&) { reads[p].push_back(column); });
+    for (std::size_t i = first; i < last; ++i) {
+      const auto [k0, k1] = row_blocks(vertex_[i]);
+      reads[p].insert(reads[p].end(), a.column.begin() + static_cast<std::ptrdiff_t>(k0), a.column.begin() + static_cast<std::ptrdiff_t>(k1));
+    }
     std::sort(reads[p].begin(), reads[p].end());
     reads[p].erase(std::unique(reads[p].begin(), reads[p].end()), reads[p].end());
     bool any_free = false;
@@ -145,11 +151,15 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
       const std::vector<VertexId> vertices = piece_vertices(static_cast<int>(p));
       const auto n = static_cast<Eigen::Index>(3 * vertices.size());
       Eigen::MatrixXd block = Eigen::MatrixXd::Zero(n, n);
-      for (std::size_t i = 0; i < vertices.size(); ++i)
-        visit_row(vertices[i], [&](VertexId column, const Mat3& value) {
-          const int j = local_index(vertices, column);
-          if (j >= 0) block.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * j) = value;
-        });
+      for (std::size_t i = 0; i < vertices.size(); ++i) {
+        const auto [k0, k1] = row_blocks(vertices[i]);
+        for (std::size_t k = k0; k < k1; ++k) {
+          const int j = local_index(vertices, a.column[k]);
+          if (j >= 0)
+            block.block<3, 3>(3 * static_cast<Eigen::Index>(i), 3 * j) =
+                Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * k);
+        }
+      }
       // Held dofs: identity rows and columns for the factorization, zero in the inverse, so the
       // piece's solve leaves them where they are.
       std::vector<Eigen::Index> held;
@@ -175,32 +185,6 @@ void WeakPieceSolves::factor_rows(Eigen::Index rows, const std::vector<std::uint
     }
   });
   factored_ = static_cast<int>(std::count_if(inverse_start_.begin(), inverse_start_.end(), [](std::int64_t start) { return start >= 0; }));
-}
-
-void WeakPieceSolves::factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed) {
-  factor_rows(a.rows(), fixed, [&](VertexId row, const auto& take) {
-    const auto r = static_cast<std::size_t>(row);
-    for (auto k = static_cast<std::size_t>(a.row_start[r]); k < static_cast<std::size_t>(a.row_start[r + 1]); ++k)
-      take(a.column[k], Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(a.values.data() + 9 * k));
-  });
-}
-
-void WeakPieceSolves::factor(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed) {
-  if (!a.isCompressed()) throw InputError("weak pieces: matrix must be compressed (makeCompressed)");
-  factor_rows(a.rows(), fixed, [&](VertexId row, const auto& take) {
-    // Gather the row's 3x3 blocks column vertex by column vertex (scalar CSR rows 3 v .. 3 v + 2).
-    std::vector<std::pair<VertexId, Mat3>> blocks;
-    for (int axis = 0; axis < 3; ++axis) {
-      const Eigen::Index i = 3 * static_cast<Eigen::Index>(row) + axis;
-      for (auto k = a.outerIndexPtr()[i]; k < a.outerIndexPtr()[i + 1]; ++k) {
-        const auto column = static_cast<VertexId>(a.innerIndexPtr()[k] / 3);
-        auto it = std::find_if(blocks.begin(), blocks.end(), [&](const auto& b) { return b.first == column; });
-        if (it == blocks.end()) it = blocks.insert(blocks.end(), {column, Mat3::Zero()});
-        it->second(axis, a.innerIndexPtr()[k] % 3) = a.valuePtr()[k];
-      }
-    }
-    for (const auto& [column, value] : blocks) take(column, value);
-  });
 }
 
 template <typename Scalar>

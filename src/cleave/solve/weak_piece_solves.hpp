@@ -71,8 +71,6 @@ class WeakPieceSolves {
   /// InputError when `a` or `fixed` do not have the level's size. Pieces whose block is not
   /// positive definite are dropped.
   void factor(const BlockSparseMatrix<double>& a, const std::vector<std::uint8_t>& fixed);
-  /// The same from compressed RowMajor scalar CSR (the coarse levels' Galerkin operators).
-  void factor(const SparseMatrix& a, const std::vector<std::uint8_t>& fixed);
 
   /// For each piece in turn: x_p += A_p^-1 (b - A x)_p on its free dofs, with the residual of
   /// the piece's rows computed afresh (so a later piece sees what an earlier one moved).
@@ -82,9 +80,6 @@ class WeakPieceSolves {
 
  private:
   friend WeakPieceSolves find_weak_pieces(const GridLevel& grid, const WeakPieceOptions& options);
-  template <typename RowVisitor>
-  void factor_rows(Eigen::Index rows, const std::vector<std::uint8_t>& fixed, const RowVisitor& visit_row);
-
   VertexId level_vertices_ = 0;
   std::vector<int> piece_start_{0};   ///< piece p's vertices: vertex_[piece_start_[p] .. piece_start_[p + 1])
   std::vector<VertexId> vertex_;
