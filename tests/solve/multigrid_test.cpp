@@ -503,5 +503,15 @@ TEST(Multigrid, ReplacingTheFineLevelRefusesOriginsOutsideTheOldLevel) {
   }
 }
 
+// A cantilevered plate 4 cells thick: coarse cells 8 or 16 cells wide stiffen its bending, and
+// the default hierarchy stops coarsening before that (21 iterations with a coarsest level of at
+// most 2,000 dofs, four levels; 17 with the default's three).
+TEST(Multigrid, AThinPlateKeepsACoarsestLevelThatBends) {
+  const TissueModel model = test::make_box({80, 80, 4}, 1.0);
+  const int iterations = multigrid_iterations(model, test::Clamp::left_end, MultigridOptions{});
+  std::printf("plate 80x80x4 cantilever: %d iterations\n", iterations);
+  EXPECT_LE(iterations, 18);
+}
+
 }  // namespace
 }  // namespace cleave
