@@ -195,6 +195,7 @@ TEST(Multigrid, CoarseLevelsDoNotCoupleThePiecesOfAFullCut) {
   const test::LinearSystem s = test::clamped_system(model, test::Clamp::both_ends);
   MultigridOptions options;
   options.coarsest_max_dofs = 100;
+  options.coarsest_factor_share = 0;  // every level down to 100 dofs
   const MultigridPreconditioner m = build_multigrid(s.a, model.volume, options);
   ASSERT_GE(m.levels().size(), 4u);
   const auto components = level_components(m, model.volume);
@@ -503,14 +504,20 @@ TEST(Multigrid, ReplacingTheFineLevelRefusesOriginsOutsideTheOldLevel) {
   }
 }
 
-// A cantilevered plate 4 cells thick: coarse cells 8 or 16 cells wide stiffen its bending, and
-// the default hierarchy stops coarsening before that (21 iterations with a coarsest level of at
-// most 2,000 dofs, four levels; 17 with the default's three).
+// A cantilevered plate 4 cells thick: coarse cells 8 or 16 cells wide stiffen its bending. Its
+// level of 2,646 dofs (cells 4 wide) factors cheaply, and the default hierarchy stops there: 17
+// iterations, against 21 one level deeper (where the dof count alone would stop).
 TEST(Multigrid, AThinPlateKeepsACoarsestLevelThatBends) {
   const TissueModel model = test::make_box({80, 80, 4}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  EXPECT_EQ(build_multigrid(s.a, model.volume).levels().size(), 3u);
   const int iterations = multigrid_iterations(model, test::Clamp::left_end, MultigridOptions{});
-  std::printf("plate 80x80x4 cantilever: %d iterations\n", iterations);
+  MultigridOptions by_dofs;
+  by_dofs.coarsest_factor_share = 0;
+  const int deeper = multigrid_iterations(model, test::Clamp::left_end, by_dofs);
+  std::printf("plate 80x80x4 cantilever: %d iterations, %d by the dof count alone\n", iterations, deeper);
   EXPECT_LE(iterations, 18);
+  EXPECT_GT(deeper, iterations);
 }
 
 }  // namespace

@@ -4,27 +4,21 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
-#include <Eigen/SparseCholesky>
 #include <algorithm>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
 #include "cleave/solve/grid_level.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
+#include "cleave/solve/coarsest_factor.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
 namespace {
 
 constexpr std::size_t kVerticesPerTask = 1024;
-/// Diagonal shift (relative to the mean diagonal) tried when the coarsest factorization fails.
-constexpr double kCoarsestShift = 1e-10;
 
 }  // namespace
-
-struct MultigridPreconditioner::CoarsestSolver {
-  Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>> ldlt;
-};
 
 MultigridPreconditioner::MultigridPreconditioner() = default;
 MultigridPreconditioner::~MultigridPreconditioner() = default;
@@ -144,6 +138,12 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     fine.fixed = identity_rows(a);
     m.levels_.push_back(std::move(fine));
   }
+  m.coarsest_ = std::make_unique<CoarsestFactor>();
+  // The coarsest level's matrix (ColMajor, as the factorizations take it), once chosen.
+  Eigen::SparseMatrix<double> coarsest;
+  std::size_t analyzed_level = 0;  // the level `coarsest` holds (0: none; the fine level is never analyzed here)
+  const auto fine_entries = static_cast<double>(a.values.size());
+  const double factor_budget = options.coarsest_factor_share * fine_entries;
   while (static_cast<int>(m.levels_.size()) < options.max_levels) {
     const std::size_t l = m.levels_.size() - 1;
     // Free dofs only: held pieces (the removed plugs of round incisions) keep their replicas of
@@ -151,6 +151,14 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     const auto& fixed = m.levels_[l].fixed;
     const auto free_dofs = static_cast<std::ptrdiff_t>(fixed.size()) - std::count(fixed.begin(), fixed.end(), std::uint8_t{1});
     if (free_dofs <= options.coarsest_max_dofs) break;
+    // A coarse level whose factor is cheap enough ends the hierarchy. A factor holds at least the
+    // lower triangle, so a level with more than twice the budget's entries is not analyzed.
+    if (l > 0 && static_cast<double>(m.levels_[l].matrix.nonZeros()) <= 2.0 * factor_budget) {
+      coarsest = m.levels_[l].matrix;
+      analyzed_level = l;
+      const FactorCost cost = m.coarsest_->analyze(coarsest);
+      if (cost.nonzeros <= factor_budget && cost.flops <= options.coarsest_factor_flops_per_fine_entry * fine_entries) break;
+    }
     Coarsening next = coarsen_grid_level(grid);
     const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
     if (ratio > options.min_coarsening_ratio) break;
@@ -185,17 +193,12 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     else if (level.weak_pieces.piece_count() > 0) level.weak_pieces.factor(to_block_sparse<double>(level.matrix), level.fixed);
   }
 
-  m.coarsest_ = std::make_unique<MultigridPreconditioner::CoarsestSolver>();
-  const Eigen::SparseMatrix<double> coarsest(m.levels_.size() == 1 ? to_scalar_sparse(a) : m.levels_.back().matrix);
-  m.coarsest_->ldlt.compute(coarsest);
-  if (m.coarsest_->ldlt.info() != Eigen::Success) {
-    const double shift = kCoarsestShift * coarsest.diagonal().cwiseAbs().mean();
-    Eigen::SparseMatrix<double> identity(coarsest.rows(), coarsest.cols());
-    identity.setIdentity();
-    m.coarsest_->ldlt.compute(coarsest + shift * identity);
-    if (m.coarsest_->ldlt.info() != Eigen::Success)
-      throw ComputeError(fmt::format("multigrid: the coarsest level ({} dofs) cannot be factored", coarsest.rows()));
+  const std::size_t last = m.levels_.size() - 1;
+  if (analyzed_level != last || last == 0) {
+    coarsest = last == 0 ? Eigen::SparseMatrix<double>(to_scalar_sparse(a)) : Eigen::SparseMatrix<double>(m.levels_[last].matrix);
+    m.coarsest_->analyze(coarsest);
   }
+  m.coarsest_->factorize(coarsest);
   if (m.precision_ == CyclePrecision::single_precision) m.allocate_cycle<float>();
   else m.allocate_cycle<double>();
   return m;
@@ -323,7 +326,7 @@ void MultigridPreconditioner::cycle(std::size_t l) const {
   const CycleData<Scalar>& data = level.data<Scalar>();
   if (l + 1 == levels_.size()) {
     const Vector rhs = data.rhs.template cast<double>();
-    data.solution = coarsest_->ldlt.solve(rhs).template cast<Scalar>();
+    data.solution = coarsest_->solve(rhs).template cast<Scalar>();
     if (!data.solution.allFinite()) data.solution.setZero();
     return;
   }

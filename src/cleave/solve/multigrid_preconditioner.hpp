@@ -4,7 +4,8 @@
 // coarsening with cell replication (coarsen_grid_level.hpp), so pieces separated by cuts stay
 // separated on every level; coarse operators are Galerkin products P^T A P with fixed dofs left
 // out of P (galerkin_operator.hpp); Chebyshev / block-Jacobi smoothing before and after the
-// coarse correction (chebyshev_smoother.hpp); a sparse Cholesky (LDL^T) solve on the coarsest level.
+// coarse correction (chebyshev_smoother.hpp); a sparse Cholesky solve on the coarsest level
+// (coarsest_factor.hpp).
 // The cycle runs in single precision on block CSR copies of the operators (block_sparse_matrix.hpp).
 //
 //   MultigridPreconditioner m = build_multigrid(a, volume);   // a: 3 n_v x 3 n_v on volume's vertices
@@ -35,13 +36,18 @@ enum class CyclePrecision {
 };
 
 struct MultigridOptions {
-  /// Stop coarsening once a level has this few free dofs. Coarse cells much wider than a thin
-  /// shell is thick stiffen its bending (trilinear cells in bending shear), so the coarsest
-  /// level is kept fine enough to bend: the abdomen at 45k cells (a shell 4-6 cells thick) needs
-  /// 21 preview iterations with a coarsest level of 4,695 dofs and 32 with 2,253 (one level
-  /// deeper), while its factor takes 19 ms instead of 5 and a solve with it 0.4 ms. The 44k
-  /// tube's levels are the same at 2,000 and 5,000 (its next is 7,320 dofs: 60 ms to factor).
-  int coarsest_max_dofs = 5000;
+  int coarsest_max_dofs = 2000;  ///< stop coarsening once a level has this few free dofs
+  /// ... or once a coarse level's Cholesky factor would hold at most this share of the fine
+  /// matrix's nonzeros (a solve with it streams about 5 % of a V-cycle's bytes) and cost at most
+  /// coarsest_factor_flops_per_fine_entry flops per fine entry to factor (about five fine
+  /// products). Coarse cells much wider than a thin shell is thick stiffen its bending, so a
+  /// shell is best served by stopping early, and its factor is cheap: the abdomen at 45k cells (a
+  /// shell 4-6 cells thick) stops at 4,695 dofs (1.3 % of the fine entries, 13 ms to factor) and
+  /// needs 21 preview iterations instead of 32 one level deeper. A solid's factor fills in: the
+  /// 44k tube's level of 7,320 dofs would hold 8 % (55 ms), so it goes one level deeper, as the
+  /// dof count alone made it. 0: by the dof count only.
+  double coarsest_factor_share = 0.05;
+  double coarsest_factor_flops_per_fine_entry = 10.0;
   double min_coarsening_ratio = 0.85;    ///< stop when a level keeps more than this share of dofs
   int max_levels = 12;
   ChebyshevOptions smoother;
@@ -99,6 +105,8 @@ struct MultigridLevel {
   }
 };
 
+class CoarsestFactor;
+
 class MultigridPreconditioner final : public Preconditioner {
  public:
   MultigridPreconditioner();
@@ -155,7 +163,6 @@ class MultigridPreconditioner final : public Preconditioner {
  private:
   friend MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume,
                                                  const MultigridOptions& options);
-  struct CoarsestSolver;
   template <typename Scalar>
   void cycle(std::size_t level) const;
   template <typename Scalar, typename Matrix>
@@ -169,7 +176,7 @@ class MultigridPreconditioner final : public Preconditioner {
 
   const VertexOperator* fine_operator_ = nullptr;  ///< when set, the fine level's operator instead of its blocks
   std::vector<MultigridLevel> levels_;
-  std::unique_ptr<CoarsestSolver> coarsest_;
+  std::unique_ptr<CoarsestFactor> coarsest_;
   CyclePrecision precision_ = CyclePrecision::single_precision;
 };
 
