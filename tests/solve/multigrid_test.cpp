@@ -6,6 +6,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <map>
 #include <string>
 
@@ -518,6 +519,28 @@ TEST(Multigrid, AThinPlateKeepsACoarsestLevelThatBends) {
   std::printf("plate 80x80x4 cantilever: %d iterations, %d by the dof count alone\n", iterations, deeper);
   EXPECT_LE(iterations, 18);
   EXPECT_GT(deeper, iterations);
+}
+
+TEST(Multigrid, RefusesACoarsestFactorBudgetOutsideItsRange) {
+  const TissueModel model = test::make_box({4, 4, 2}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  const auto message_of = [&](const MultigridOptions& options) -> std::string {
+    try {
+      (void)build_multigrid(s.a, model.volume, options);
+    } catch (const InputError& e) {
+      return e.what();
+    }
+    return "no error";
+  };
+  MultigridOptions share;
+  share.coarsest_factor_share = -0.1;
+  EXPECT_EQ(message_of(share), "multigrid: coarsest factor share is -0.1; expected a share from 0 to 1 of the fine matrix's entries");
+  share.coarsest_factor_share = std::nan("");
+  EXPECT_EQ(message_of(share), "multigrid: coarsest factor share is nan; expected a share from 0 to 1 of the fine matrix's entries");
+  MultigridOptions flops;
+  flops.coarsest_factor_flops_per_fine_entry = -1;
+  EXPECT_EQ(message_of(flops), "multigrid: coarsest factor flops per fine entry is -1; expected a finite number of 0 or more");
+  EXPECT_EQ(message_of(MultigridOptions{}), "no error");
 }
 
 }  // namespace

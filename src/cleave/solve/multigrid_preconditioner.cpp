@@ -5,6 +5,7 @@
 #include <tbb/parallel_for.h>
 
 #include <algorithm>
+#include <cmath>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
@@ -130,6 +131,12 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (a.rows() != dofs)
     throw InputError(fmt::format("multigrid: matrix has {} rows; expected {} (3 dofs per vertex of the linked volume)", a.rows(), dofs));
+  if (!(options.coarsest_factor_share >= 0 && options.coarsest_factor_share <= 1))
+    throw InputError(fmt::format("multigrid: coarsest factor share is {}; expected a share from 0 to 1 of the fine matrix's entries",
+                                 options.coarsest_factor_share));
+  if (!(options.coarsest_factor_flops_per_fine_entry >= 0 && std::isfinite(options.coarsest_factor_flops_per_fine_entry)))
+    throw InputError(fmt::format("multigrid: coarsest factor flops per fine entry is {}; expected a finite number of 0 or more",
+                                 options.coarsest_factor_flops_per_fine_entry));
   MultigridPreconditioner m;
   m.levels_.reserve(static_cast<std::size_t>(std::max(options.max_levels, 1)));  // no reallocation: it would copy the levels' matrices
   GridLevel grid = grid_level_of(volume);
