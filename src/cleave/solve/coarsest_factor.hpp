@@ -40,7 +40,6 @@ class CoarsestFactor {
   /// a^-1 b with the factor. InputError when b's size is not the factor's order.
   Eigen::VectorXd solve(const Eigen::VectorXd& b) const;
 
-  Eigen::Index order() const { return order_; }
   /// Whether the factor is the LDL^T fallback (the level was not positive definite).
   bool shifted() const;
 

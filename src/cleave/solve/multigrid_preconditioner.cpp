@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <optional>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
@@ -148,7 +149,7 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   m.coarsest_ = std::make_unique<CoarsestFactor>();
   // The coarsest level's matrix (ColMajor, as the factorizations take it), once chosen.
   Eigen::SparseMatrix<double> coarsest;
-  std::size_t analyzed_level = 0;  // the level `coarsest` holds (0: none; the fine level is never analyzed here)
+  std::optional<std::size_t> analyzed_level;  // the level `coarsest` holds and the factor has analyzed
   const auto fine_entries = static_cast<double>(a.values.size());
   const double factor_budget = options.coarsest_factor_share * fine_entries;
   while (static_cast<int>(m.levels_.size()) < options.max_levels) {
@@ -201,7 +202,7 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   }
 
   const std::size_t last = m.levels_.size() - 1;
-  if (analyzed_level != last || last == 0) {
+  if (analyzed_level != last) {
     coarsest = last == 0 ? Eigen::SparseMatrix<double>(to_scalar_sparse(a)) : Eigen::SparseMatrix<double>(m.levels_[last].matrix);
     m.coarsest_->analyze(coarsest);
   }
