@@ -123,8 +123,9 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
     ms.push_back(std::chrono::duration<double, std::milli>(Clock::now() - t).count());
     with_cut_ms.push_back(ms.back() + cut_ms);
     const double cpu_ms = 1000.0 * static_cast<double>(std::clock() - cpu) / CLOCKS_PER_SEC;
-    std::printf("step %2d  %8.1f ms wall  %8.1f ms cpu (all threads)  %3d it  residual %.1e  cut before it %6.1f ms wall\n", i,
-                ms.back(), cpu_ms, r.iterations, r.relative_residual, cut_ms);
+    std::printf("step %2d  %8.1f ms wall  %8.1f ms cpu (all threads)  %3d it  residual %.1e (from %.1e)  cut before it %6.1f ms wall  |u| %.4g mm\n",
+                i, ms.back(), cpu_ms, r.iterations, r.relative_residual, r.initial_relative_residual, cut_ms,
+                sim.displacement().lpNorm<Eigen::Infinity>());
     std::fflush(stdout);
     EXPECT_TRUE(r.converged);
   }

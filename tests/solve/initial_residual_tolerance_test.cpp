@@ -1,6 +1,7 @@
 // SolveSettings::initial_residual_tolerance: the CG solvers of cleave also stop once the residual
 // is that fraction of the initial guess's residual (the dynamic step's rule), report it, and
-// otherwise behave as with relative_tolerance alone.
+// otherwise behave as with relative_tolerance alone. SolveSettings::zero_start_when_better: the
+// guess gives way to x = 0 when it is farther from the solution in the energy norm.
 #include <gtest/gtest.h>
 
 #include "cleave/solve/conjugate_gradient.hpp"
@@ -71,6 +72,75 @@ TEST(InitialResidualTolerance, TheTighterRelativeRuleWinsWhenTheStartIsPoor) {
   EXPECT_LE(b.relative_residual, 0.1);
   EXPECT_NEAR(b.initial_relative_residual, 1.0, 1e-12);
   EXPECT_LT(b.iterations, a.iterations);
+}
+
+TEST(ZeroStartWhenBetter, KeepsAGuessCloserInEnergyEvenWithTheLargerResidual) {
+  // A = diag(1, 1e4), b = (1, 0), x* = (1, 0), ||x*||_A^2 = 1. Guess (1, 1e-3): residual
+  // (0, -10), ten times ||b||, but energy error 1e4 * 1e-6 = 0.01 < 1: kept. Guess (1, 0.1):
+  // energy error 100 > 1: replaced by 0. Zero iterations, so x is the chosen start.
+  SparseMatrix a(2, 2);
+  a.insert(0, 0) = 1.0;
+  a.insert(1, 1) = 1e4;
+  a.makeCompressed();
+  const Vector b = Vector::Unit(2, 0);
+  SolveSettings settings;
+  settings.max_iterations = 0;
+  settings.zero_start_when_better = true;
+
+  Vector close(2);
+  close << 1.0, 1e-3;
+  Vector x = close;
+  SolveReport r = preconditioned_cg(a, b, x, IdentityPreconditioner(), settings);
+  EXPECT_EQ(x, close);
+  EXPECT_NEAR(r.initial_relative_residual, 10.0, 1e-12);
+
+  Vector far(2);
+  far << 1.0, 0.1;
+  x = far;
+  r = preconditioned_cg(a, b, x, IdentityPreconditioner(), settings);
+  EXPECT_EQ(x, Vector::Zero(2));
+  EXPECT_NEAR(r.initial_relative_residual, 1.0, 1e-12);
+
+  settings.zero_start_when_better = false;  // off: the guess stays whatever it is
+  x = far;
+  r = preconditioned_cg(a, b, x, IdentityPreconditioner(), settings);
+  EXPECT_EQ(x, far);
+  EXPECT_NEAR(r.initial_relative_residual, 1000.0, 1e-9);
+}
+
+TEST(ZeroStartWhenBetter, TheMultigridStartsFromZeroForAnOvershootingGuessAndStopsRelativeToIt) {
+  // A Newmark-like overshoot: the exact solution plus a large checkerboard (stiff) component.
+  TissueModel model = test::make_box({12, 4, 4}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  Vector exact = Vector::Zero(s.b.size());
+  {
+    SolveSettings tight;
+    tight.relative_tolerance = 1e-11;
+    auto solver = make_linear_solver(SolverKind::multigrid_cg, tight);
+    solver->setup(s.a, model.volume);
+    ASSERT_TRUE(solver->solve(s.b, exact).converged);
+  }
+  Vector overshoot = exact;
+  for (Eigen::Index i = 0; i < overshoot.size(); ++i) overshoot[i] += (i % 2 == 0 ? 1.0 : -1.0) * 10.0 * exact.cwiseAbs().maxCoeff();
+  SolveSettings settings;
+  settings.initial_residual_tolerance = 1e-5;
+  settings.zero_start_when_better = true;
+  auto solver = make_linear_solver(SolverKind::multigrid_cg, settings);
+  solver->setup(s.a, model.volume);
+  Vector x = overshoot;
+  const SolveReport r = solver->solve(s.b, x);
+  EXPECT_TRUE(r.converged);
+  EXPECT_NEAR(r.initial_relative_residual, 1.0, 1e-12);  // the start was x = 0
+  EXPECT_LE((s.b - s.a * x).norm(), 1e-5 * s.b.norm() * (1 + 1e-9));
+  // Without it the same rule stops at 1e-5 of the overshoot's residual: a far worse solution.
+  settings.zero_start_when_better = false;
+  auto plain = make_linear_solver(SolverKind::multigrid_cg, settings);
+  plain->setup(s.a, model.volume);
+  Vector y = overshoot;
+  const SolveReport q = plain->solve(s.b, y);
+  EXPECT_TRUE(q.converged);
+  EXPECT_GT(q.initial_relative_residual, 100.0);
+  EXPECT_GT((y - exact).norm(), 10.0 * (x - exact).norm());
 }
 
 }  // namespace

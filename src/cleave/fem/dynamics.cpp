@@ -34,6 +34,7 @@ Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_k
     throw InputError(fmt::format("step tolerance is {}; expected a number from 0 to below 1", settings_.step_tolerance));
   SolveSettings step_solve = settings_.solve;
   step_solve.initial_residual_tolerance = settings_.step_tolerance;
+  step_solve.zero_start_when_better = true;
   solver_ = make_linear_solver(settings_.solver, step_solve);
   const FixedDofs held = fix_vertices(volume.vertex_count(), settings_.fixed_vertices);
   fixed_ = held.fixed;
@@ -319,7 +320,8 @@ SolveReport Dynamics::step(double dt) {
   if (alpha_m > 0) rhs -= alpha_m * mass_.cwiseProduct(damped_velocity);
 
   // Fixed dofs are held at zero: their rows are identity rows with a zero right-hand side.
-  Vector du = dt * v_ + 0.5 * dt * dt * a_;  // Newmark predictor: warm start
+  // The Newmark predictor, or no increment where that is closer (the solver's zero_start_when_better).
+  Vector du = dt * v_ + 0.5 * dt * dt * a_;
   for (std::size_t i = 0; i < fixed_.size(); ++i)
     if (fixed_[i] != 0) {
       du[static_cast<Eigen::Index>(i)] = 0.0;

@@ -44,13 +44,22 @@ class IterationProduct<VertexOperator> {
 };
 
 /// Plain PCG from x; `iterations` is increased by the iterations done. When `initial_norm` is not
-/// null it receives ||b - A x|| of the start (before any iteration).
+/// null it receives ||b - A x|| of the start (before any iteration); with `zero_when_better` the
+/// start is x = 0 instead when x is farther from the solution in the energy norm (see
+/// SolveSettings::zero_start_when_better).
 template <typename Matrix>
 CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, IterationProduct<Matrix>& product,
-               double& target, double initial_factor, double* initial_norm, int max_iterations, int& iterations) {
+               double& target, double initial_factor, double* initial_norm, bool zero_when_better, int max_iterations,
+               int& iterations) {
   const Eigen::Index n = a.rows();
   Vector r(n), z(n), p(n), q(n);
   residual(a, b, x, r);
+  // 1/2 ||x - x*||_A^2 - 1/2 ||x*||_A^2 = 1/2 x^T A x - b^T x = -1/2 x^T (b + r): above zero, the
+  // guess is worse than x = 0, whose value it is.
+  if (zero_when_better && x.dot(b + r) < 0) {
+    x.setZero();
+    r = b;
+  }
   if (initial_norm != nullptr) {
     *initial_norm = r.norm();
     target = std::max(target, initial_factor * *initial_norm);
@@ -101,7 +110,7 @@ SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, c
   IterationProduct<Matrix> product(settings);
   for (int restart = 0; restart <= kMaxRestarts; ++restart) {
     const CgStop stop = run_pcg(a, b, x, preconditioner, product, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
-                                settings.max_iterations, report.iterations);
+                                restart == 0 && settings.zero_start_when_better, settings.max_iterations, report.iterations);
     if (!x.allFinite()) x = start;
     residual(a, b, x, r);
     r_norm = r.norm();

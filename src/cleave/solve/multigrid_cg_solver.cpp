@@ -179,6 +179,7 @@ class MultigridCgSolver final : public LinearSolver {
     rest.max_iterations = iterations_left;
     rest.relative_tolerance = std::max(settings.relative_tolerance, settings.initial_residual_tolerance * first.initial_relative_residual);
     rest.initial_residual_tolerance = 0;
+    rest.zero_start_when_better = false;  // x holds the first part's progress
     return rest;
   }
 
