@@ -58,8 +58,8 @@ struct DynamicsSettings {
   /// Newmark predictor, or from no increment where that is closer in the energy norm
   /// (SolveSettings::zero_start_when_better): at display rates the predictor's acceleration term
   /// overshoots the stiff modes (after a cut on the 44k tube its residual was 1e3-1e4 times that
-  /// of no increment, and steps stopped at 1e-5 of it were off by 4-7 % of the motion on the
-  /// bench's cut, 60-110 % on the abdomen's opening at dt = 0.03 s; from the better start 1e-4).
+  /// of no increment, and steps stopped at 1e-5 of it were off by up to 7 % of the motion on the
+  /// bench's cut, up to 110 % on the abdomen's opening at dt = 0.03 s; from the better start 2e-4).
   /// 0: stop at solve.relative_tolerance of the whole right-hand side alone.
   double step_tolerance = 1e-5;
   double mass_damping_per_s = 0;        ///< Rayleigh alpha (1/s)
