@@ -121,7 +121,8 @@ TEST(ZeroStartWhenBetter, TheMultigridStartsFromZeroForAnOvershootingGuessAndSto
     ASSERT_TRUE(solver->solve(s.b, exact).converged);
   }
   Vector overshoot = exact;
-  for (Eigen::Index i = 0; i < overshoot.size(); ++i) overshoot[i] += (i % 2 == 0 ? 1.0 : -1.0) * 10.0 * exact.cwiseAbs().maxCoeff();
+  const double largest = exact.cwiseAbs().maxCoeff();
+  for (Eigen::Index i = 0; i < overshoot.size(); ++i) overshoot[i] += (i % 2 == 0 ? 10.0 : -10.0) * largest;
   SolveSettings settings;
   settings.initial_residual_tolerance = 1e-5;
   settings.zero_start_when_better = true;
