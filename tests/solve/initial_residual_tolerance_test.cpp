@@ -10,18 +10,22 @@
 namespace cleave {
 namespace {
 
+/// The system's solution to 1e-11 of ||b|| (multigrid CG from zero).
+Vector tight_solution(const test::LinearSystem& s, const TissueModel& model) {
+  SolveSettings tight;
+  tight.relative_tolerance = 1e-11;
+  auto solver = make_linear_solver(SolverKind::multigrid_cg, tight);
+  solver->setup(s.a, model.volume);
+  Vector x = Vector::Zero(s.b.size());
+  EXPECT_TRUE(solver->solve(s.b, x).converged);
+  return x;
+}
+
 TEST(InitialResidualTolerance, StopsAtThatFractionOfTheWarmStartResidual) {
   TissueModel model = test::make_box({12, 4, 4}, 1.0);
   const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
   // A good warm start: the exact solution disturbed by 1 %.
-  Vector exact = Vector::Zero(s.b.size());
-  {
-    SolveSettings tight;
-    tight.relative_tolerance = 1e-11;
-    auto solver = make_linear_solver(SolverKind::multigrid_cg, tight);
-    solver->setup(s.a, model.volume);
-    ASSERT_TRUE(solver->solve(s.b, exact).converged);
-  }
+  const Vector exact = tight_solution(s, model);
   Vector start = exact;
   for (Eigen::Index i = 0; i < start.size(); ++i) start[i] *= 1.0 + 0.01 * std::sin(0.37 * static_cast<double>(i));
   const double initial = (s.b - s.a * start).norm();
@@ -112,33 +116,27 @@ TEST(ZeroStartWhenBetter, TheMultigridStartsFromZeroForAnOvershootingGuessAndSto
   // A Newmark-like overshoot: the exact solution plus a large checkerboard (stiff) component.
   TissueModel model = test::make_box({12, 4, 4}, 1.0);
   const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
-  Vector exact = Vector::Zero(s.b.size());
-  {
-    SolveSettings tight;
-    tight.relative_tolerance = 1e-11;
-    auto solver = make_linear_solver(SolverKind::multigrid_cg, tight);
-    solver->setup(s.a, model.volume);
-    ASSERT_TRUE(solver->solve(s.b, exact).converged);
-  }
+  const Vector exact = tight_solution(s, model);
   Vector overshoot = exact;
   const double largest = exact.cwiseAbs().maxCoeff();
   for (Eigen::Index i = 0; i < overshoot.size(); ++i) overshoot[i] += (i % 2 == 0 ? 10.0 : -10.0) * largest;
-  SolveSettings settings;
-  settings.initial_residual_tolerance = 1e-5;
-  settings.zero_start_when_better = true;
-  auto solver = make_linear_solver(SolverKind::multigrid_cg, settings);
-  solver->setup(s.a, model.volume);
-  Vector x = overshoot;
-  const SolveReport r = solver->solve(s.b, x);
+  // Multigrid CG at 1e-5 of the start's residual from the overshoot, with or without the rule.
+  const auto solve_from_overshoot = [&](bool zero_start_when_better, Vector& x) {
+    SolveSettings settings;
+    settings.initial_residual_tolerance = 1e-5;
+    settings.zero_start_when_better = zero_start_when_better;
+    auto solver = make_linear_solver(SolverKind::multigrid_cg, settings);
+    solver->setup(s.a, model.volume);
+    x = overshoot;
+    return solver->solve(s.b, x);
+  };
+  Vector x, y;
+  const SolveReport r = solve_from_overshoot(true, x);
   EXPECT_TRUE(r.converged);
   EXPECT_NEAR(r.initial_relative_residual, 1.0, 1e-12);  // the start was x = 0
   EXPECT_LE((s.b - s.a * x).norm(), 1e-5 * s.b.norm() * (1 + 1e-9));
   // Without it the same rule stops at 1e-5 of the overshoot's residual: a far worse solution.
-  settings.zero_start_when_better = false;
-  auto plain = make_linear_solver(SolverKind::multigrid_cg, settings);
-  plain->setup(s.a, model.volume);
-  Vector y = overshoot;
-  const SolveReport q = plain->solve(s.b, y);
+  const SolveReport q = solve_from_overshoot(false, y);
   EXPECT_TRUE(q.converged);
   EXPECT_GT(q.initial_relative_residual, 100.0);
   EXPECT_GT((y - exact).norm(), 10.0 * (x - exact).norm());
