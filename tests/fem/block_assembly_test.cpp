@@ -120,5 +120,38 @@ TEST(BlockAssembly, FixedDofEliminationOnBlocksEqualsTheScalarOne) {
   EXPECT_EQ(b_blocks[3 * 3 + 1], 0.3);
 }
 
+// The dynamic step's block pattern is made without scalar CSR and, after a cut, patched in place
+// (rows of untouched vertices copied): both must be exactly the block pattern of the scalar one.
+TEST(BlockAssembly, BlockPatternAndItsRepatchAfterACutEqualTheScalarPattern) {
+  TissueModel model = test::make_box_model({10, 8, 4}, 1.5, 60.0, 0.42);
+  LinkedVolume& volume = model.volume;
+  BlockSparseMatrix<double> blocks = make_vertex_block_csr(volume);
+  const BlockSparseMatrix<double> from_scalar = to_block_sparse<double>(make_vertex_block_pattern(volume));
+  EXPECT_EQ(blocks.row_start, from_scalar.row_start);
+  EXPECT_EQ(blocks.column, from_scalar.column);
+  ASSERT_EQ(blocks.values.size(), 9 * blocks.blocks());
+  EXPECT_EQ(std::count(blocks.values.begin(), blocks.values.end(), 0.0), static_cast<std::ptrdiff_t>(blocks.values.size()));
+  // Two cuts, the second through vertices the first divided: each repatch sees the rows its own
+  // cut touched (the dynamics passes the union of all cuts since its last pattern).
+  std::vector<std::uint8_t> affected;
+  for (const int depth : {2, 3}) {
+    const VertexId before = volume.vertex_count();
+    const CutReport report = volume.cut_links(test::faces_between(volume, [&](CellId c) {
+      const Vec3i v = volume.cell_voxel(c);
+      return v.x() < depth && v.y() < 2;
+    }));
+    ASSERT_GT(volume.vertex_count(), before);
+    const std::vector<std::uint8_t> touched = vertices_affected_by_cut(volume, report);
+    affected.resize(touched.size(), 0);
+    for (std::size_t v = 0; v < touched.size(); ++v) affected[v] |= touched[v];
+  }
+  ASSERT_LT(std::count(affected.begin(), affected.end(), std::uint8_t{1}), static_cast<std::ptrdiff_t>(affected.size()) / 3);
+  repattern_vertex_block_csr(volume, blocks, affected);
+  const BlockSparseMatrix<double> cut_from_scalar = to_block_sparse<double>(make_vertex_block_pattern(volume));
+  EXPECT_EQ(blocks.row_start, cut_from_scalar.row_start);
+  EXPECT_EQ(blocks.column, cut_from_scalar.column);
+  EXPECT_EQ(blocks.values.size(), 9 * blocks.blocks());
+}
+
 }  // namespace
 }  // namespace cleave

@@ -51,7 +51,7 @@ std::string_view Dynamics::solver_name() const { return solver_->name(); }
 
 void Dynamics::rebuild_topology(const CutReport* cut) {
   mass_ = lumped_mass(model_, table_);
-  if (cut != nullptr && system_.rows() > 0) {
+  if (cut != nullptr && system_blocks_.block_rows() > 0) {
     // After a cut only the rows of the vertices it touched are patterned afresh, and only when an
     // assembly needs them (steps with the operator do not): the touched rows of all cuts since.
     const std::vector<std::uint8_t> touched = vertices_affected_by_cut(model_.volume, *cut);
@@ -60,8 +60,7 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
     pattern_current_ = false;
     if (!settings_.matrix_free) ensure_pattern();
   } else {
-    SparseMatrix pattern = make_vertex_block_pattern(model_.volume);
-    system_.swap(pattern);  // Eigen 3.4's SparseMatrix has no move: assigning the temporary would copy it
+    system_blocks_ = make_vertex_block_csr(model_.volume);
     rows_to_pattern_.clear();
     pattern_current_ = false;
     ensure_pattern();
@@ -73,12 +72,9 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
 
 void Dynamics::ensure_pattern() {
   if (pattern_current_) return;
-  if (!rows_to_pattern_.empty()) {
-    SparseMatrix rebuilt = rebuild_vertex_block_pattern(model_.volume, system_, rows_to_pattern_);
-    system_.swap(rebuilt);  // no move in Eigen 3.4's SparseMatrix: a swap instead of a copy
-  }
+  if (!rows_to_pattern_.empty()) repattern_vertex_block_csr(model_.volume, system_blocks_, rows_to_pattern_);
   rows_to_pattern_.clear();
-  system_blocks_ = to_block_sparse<double>(system_);
+  scalar_current_ = false;
   gather_ = make_vertex_block_gather(model_.volume, system_blocks_);
   diagonal_block_.assign(static_cast<std::size_t>(system_blocks_.block_rows()), 0);
   for (Eigen::Index v = 0; v < system_blocks_.block_rows(); ++v) {
@@ -221,7 +217,7 @@ void Dynamics::assemble_system(double c_stiff, double c_stress, double c_mass) {
   });
 }
 
-void Dynamics::hand_system_to_solver(double c_mass) {
+void Dynamics::hand_system_to_solver(double c_stiff, double c_stress, double c_mass) {
   // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
   // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
   // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
@@ -229,8 +225,23 @@ void Dynamics::hand_system_to_solver(double c_mass) {
   const VertexId vertices = model_.volume.vertex_count();
   const bool keep = solver_ready_ && solver_mass_factor_ == c_mass && origins_known();
   const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
-  if (!taken_as_blocks) {
-    copy_block_values(system_blocks_, system_);
+  bool set_up_with_operator = false;
+  if (!taken_as_blocks && settings_.matrix_free) {
+    system_operator_.set_state(rotations_, tension_kPa_, c_stiff, c_stress, c_mass, mass_, fixed_);
+    set_up_with_operator = solver_->setup_operator(system_operator_, system_blocks_, model_.volume);
+  }
+  if (set_up_with_operator) {
+    solver_ready_ = true;
+    solver_mass_factor_ = c_mass;
+    ++matrix_free_steps_;
+  } else if (!taken_as_blocks) {
+    if (scalar_current_) {
+      copy_block_values(system_blocks_, system_);
+    } else {
+      SparseMatrix scalar = to_scalar_sparse(system_blocks_);
+      system_.swap(scalar);  // Eigen 3.4's SparseMatrix has no move: assigning the temporary would copy it
+      scalar_current_ = true;
+    }
     if (keep && origin_of_new_.empty()) {
       solver_->update_values(system_, model_.volume);
     } else if (keep) {
@@ -341,7 +352,7 @@ SolveReport Dynamics::step(double dt) {
         held.value_mm = Vector::Zero(u_.size());
         eliminate_fixed_dofs(system_blocks_, rhs, held);
       }
-      hand_system_to_solver(c_mass);
+      hand_system_to_solver(c_stiff, w, c_mass);
     }
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));

@@ -139,8 +139,10 @@ class Dynamics {
   /// no scaling pass); K_sigma from tension_kPa_.
   void assemble_system(double c_stiff, double c_stress, double c_mass);
   /// Gives the solver the assembled system (mass term c_mass): block values where it takes
-  /// them, else system_.
-  void hand_system_to_solver(double c_mass);
+  /// them; else, for a matrix-free set-up, system_operator_ with the blocks to build from (the
+  /// multigrid's rebuilds: no scalar copy, no fine-level copy, the step applied cell by cell);
+  /// else system_.
+  void hand_system_to_solver(double c_stiff, double c_stress, double c_mass);
   /// Gives the solver the system as system_operator_ (no assembly) where it takes it: the
   /// topology and the mass term are those it was last given. false: assemble.
   bool hand_operator_to_solver(double c_stiff, double c_stress, double c_mass);
@@ -161,11 +163,12 @@ class Dynamics {
   VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
   CorotatedSystemOperator system_operator_;  ///< the same system applied cell by cell
   std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_
-  /// The same matrix as scalar CSR (vertex block pattern of the topology), filled from the blocks
-  /// only when a solver asks for it (setup, a cut, CHOLMOD).
+  /// The same matrix as scalar CSR (vertex block pattern of the topology), made and filled from
+  /// the blocks only when a solver asks for it (CHOLMOD, Eigen's CG, the assembled steps).
   SparseMatrix system_;
+  bool scalar_current_ = false;  ///< system_ has the pattern of system_blocks_
   bool any_fixed_ = false;
-  /// The block pattern (system_, system_blocks_, gather_, diagonal_block_) is that of the current
+  /// The block pattern (system_blocks_, gather_, diagonal_block_) is that of the current
   /// topology; after cuts it is rebuilt only when a step assembles.
   bool pattern_current_ = false;
   std::vector<std::uint8_t> rows_to_pattern_;  ///< per vertex: a row the cuts since the pattern touched

@@ -75,7 +75,66 @@ SparseMatrix build_pattern(const LinkedVolume& volume, const SparseMatrix* previ
   return m;
 }
 
+/// The block rows and columns of the current topology (values untouched): rows of unaffected
+/// vertices copied from `previous` when given. Shared by the fresh and the incremental pattern.
+void build_block_pattern(const LinkedVolume& volume, const BlockSparseMatrix<double>* previous, const std::vector<std::uint8_t>* affected,
+                         std::vector<std::int32_t>& row_start, std::vector<std::int32_t>& column) {
+  const VertexId n = volume.vertex_count();
+  volume.vertex_cells();  // build the lazy cache before the parallel loops
+  const auto copied = [&](VertexId v) {
+    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && v < previous->block_rows();
+  };
+  row_start.assign(static_cast<std::size_t>(n) + 1, 0);
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
+    std::vector<VertexId> neighbours;
+    for (VertexId v = range.begin(); v != range.end(); ++v) {
+      const auto row = static_cast<std::size_t>(v);
+      if (copied(v)) {
+        row_start[row + 1] = previous->row_start[row + 1] - previous->row_start[row];
+      } else {
+        vertex_neighbours(volume, v, neighbours);
+        row_start[row + 1] = static_cast<std::int32_t>(neighbours.size());
+      }
+    }
+  });
+  for (std::size_t row = 0; row < static_cast<std::size_t>(n); ++row) row_start[row + 1] += row_start[row];
+  column.resize(static_cast<std::size_t>(row_start.back()));
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
+    std::vector<VertexId> neighbours;
+    for (VertexId v = range.begin(); v != range.end(); ++v) {
+      const auto row = static_cast<std::size_t>(v);
+      auto* columns = column.data() + row_start[row];
+      if (copied(v)) {
+        const auto from = previous->column.begin() + previous->row_start[row];
+        std::copy(from, previous->column.begin() + previous->row_start[row + 1], columns);
+        continue;
+      }
+      vertex_neighbours(volume, v, neighbours);
+      std::copy(neighbours.begin(), neighbours.end(), columns);
+    }
+  });
+}
+
 }  // namespace
+
+BlockSparseMatrix<double> make_vertex_block_csr(const LinkedVolume& volume) {
+  BlockSparseMatrix<double> m;
+  build_block_pattern(volume, nullptr, nullptr, m.row_start, m.column);
+  m.values.assign(9 * m.column.size(), 0.0);
+  return m;
+}
+
+void repattern_vertex_block_csr(const LinkedVolume& volume, BlockSparseMatrix<double>& matrix, const std::vector<std::uint8_t>& affected) {
+  std::vector<std::int32_t> row_start, column;
+  build_block_pattern(volume, &matrix, &affected, row_start, column);
+  matrix.row_start.swap(row_start);
+  matrix.column.swap(column);
+  // The value buffer is kept: fresh memory costs a page fault per 4 KB page (100 MB at 44k cells:
+  // ~200 ms on this machine's virtualized memory), so it grows with headroom for later cuts.
+  const std::size_t values = 9 * matrix.column.size();
+  if (values > matrix.values.capacity()) matrix.values.reserve(values + values / 16);
+  matrix.values.resize(values);
+}
 
 SparseMatrix make_vertex_block_pattern(const LinkedVolume& volume) { return build_pattern(volume, nullptr, nullptr); }
 

@@ -122,6 +122,17 @@ class LinearSolver {
     (void)origin_of_new;
     return false;
   }
+  /// setup() for a matrix applied without its values from now on (as update_operator; `a` is
+  /// referenced and must outlive the solves), given also assembled as block CSR (`blocks`, the
+  /// same values, fixed dofs eliminated) for what needs its entries: the multigrid builds its
+  /// coarse levels from them and keeps no copy. Any topology (no relation to the last setup).
+  /// false (the default), with nothing done: the solver needs the scalar matrix (setup()).
+  virtual bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology) {
+    (void)a;
+    (void)blocks;
+    (void)topology;
+    return false;
+  }
   /// update_topology() with the new matrix also given as block CSR (the same values, its block
   /// pattern): the multigrid then takes the blocks instead of converting `a`. The default ignores
   /// them.

@@ -103,6 +103,27 @@ class MultigridCgSolver final : public LinearSolver {
     return true;
   }
 
+  bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology) override {
+    if (blocks.rows() != a.rows())
+      throw InputError(fmt::format("multigrid: the block copy of the operator has {} rows; the operator has {}", blocks.rows(), a.rows()));
+    preconditioner_ = MultigridPreconditioner();  // the old levels go before the new ones are built
+    a_blocks_ = BlockSparseMatrix<double>();
+    pattern_row_start_.clear();
+    rows_ = a.rows();
+    preconditioner_ = build_multigrid_for_operator(a, blocks, topology, options_);
+    if (preconditioner_.uses_fine_operator()) {
+      operator_ = &a;
+    } else {  // one level: its factorization preconditions, CG multiplies with the blocks
+      operator_ = nullptr;
+      a_blocks_ = blocks;
+    }
+    topology_ = &topology;
+    stale_updates_ = 0;
+    baseline_iterations_ = -1;
+    rebuild_requested_ = false;
+    return true;
+  }
+
   void update_topology(const SparseMatrix& a, const LinkedVolume& topology, const std::vector<VertexId>& origin_of_new) override {
     replace_fine_level(a, nullptr, topology, origin_of_new);
   }
@@ -128,12 +149,10 @@ class MultigridCgSolver final : public LinearSolver {
     // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
     preconditioner_ = MultigridPreconditioner();
     if (operator_ != nullptr) {
-      const SparseMatrix assembled = operator_->assembled_matrix();
-      a_blocks_ = to_block_sparse<double>(assembled);
-      remember_pattern(assembled);
-      operator_ = nullptr;
+      setup_operator(*operator_, to_block_sparse<double>(operator_->assembled_matrix()), *topology_);
+    } else {
+      build(*topology_);  // the blocks hold the current values (update_values and update_block_values keep them so)
     }
-    build(*topology_);  // the blocks hold the current values (update_values and update_block_values keep them so)
     const SolveSettings rest = continuation(settings_, stale, settings_.max_iterations - stale.iterations);
     SolveReport report = solve_with(b, x, rest);
     baseline_iterations_ = report.iterations;

@@ -14,6 +14,7 @@
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/coarsest_factor.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
+#include "cleave/solve/vertex_operator.hpp"
 
 namespace cleave {
 namespace {
@@ -128,7 +129,25 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
   return build_multigrid(to_block_sparse<double>(a), volume, options);
 }
 
+MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator, const LinkedVolume& volume,
+                                     const MultigridOptions& options);
+
 MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume, const MultigridOptions& options) {
+  return build_levels(a, nullptr, volume, options);
+}
+
+MultigridPreconditioner build_multigrid_for_operator(const VertexOperator& fine, const BlockSparseMatrix<double>& a,
+                                                     const LinkedVolume& volume, const MultigridOptions& options) {
+  if (fine.rows() != a.rows() || fine.fixed_dofs().size() != static_cast<std::size_t>(a.rows()))
+    throw InputError(fmt::format("multigrid: the fine operator has {} rows and {} fixed flags; its assembled matrix has {} rows",
+                                 fine.rows(), fine.fixed_dofs().size(), a.rows()));
+  return build_levels(a, &fine, volume, options);
+}
+
+/// build_multigrid, with the fine level applied by `fine_operator` when it is given (see
+/// build_multigrid_for_operator).
+MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator, const LinkedVolume& volume,
+                                     const MultigridOptions& options) {
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (a.rows() != dofs)
     throw InputError(fmt::format("multigrid: matrix has {} rows; expected {} (3 dofs per vertex of the linked volume)", a.rows(), dofs));
@@ -143,7 +162,7 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   GridLevel grid = grid_level_of(volume);
   {
     MultigridLevel fine;
-    fine.fixed = identity_rows(a);
+    fine.fixed = fine_operator != nullptr ? fine_operator->fixed_dofs() : identity_rows(a);
     m.levels_.push_back(std::move(fine));
   }
   m.coarsest_ = std::make_unique<CoarsestFactor>();
@@ -170,7 +189,8 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
     Coarsening next = coarsen_grid_level(grid);
     const double ratio = static_cast<double>(next.coarse.vertex_count) / static_cast<double>(grid.vertex_count);
     if (ratio > options.min_coarsening_ratio) break;
-    m.levels_[l].weak_pieces = find_weak_pieces(grid, options.weak_pieces);
+    // An operator's fine level has no rows to solve pieces with.
+    if (l > 0 || fine_operator == nullptr) m.levels_[l].weak_pieces = find_weak_pieces(grid, options.weak_pieces);
     // Built in place: Eigen 3.4's SparseMatrix has no move, so assigning or moving one copies it.
     SparseMatrix galerkin = l == 0 ? galerkin_operator(a, m.levels_[l].fixed, next.prolongation)
                                    : galerkin_operator(m.levels_[l].matrix, m.levels_[l].fixed, next.prolongation);
@@ -183,10 +203,18 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
   m.precision_ = options.precision;
   if (options.coarse_degree < 1)
     throw InputError(fmt::format("multigrid: coarse smoother degree is {}; expected 1 or more", options.coarse_degree));
+  const bool apply_fine_operator = fine_operator != nullptr && m.levels_.size() > 1;
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     MultigridLevel& level = m.levels_[l];
     ChebyshevOptions smoother = options.smoother;
     if (l > 0) smoother.degree = options.coarse_degree;
+    if (l == 0 && apply_fine_operator) {
+      m.fine_operator_ = fine_operator;
+      level.smoother = m.precision_ == CyclePrecision::single_precision
+                           ? make_chebyshev_smoother<float>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother)
+                           : make_chebyshev_smoother<double>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother);
+      continue;
+    }
     if (m.precision_ == CyclePrecision::single_precision) {
       level.single.blocks = l == 0 ? single_precision_copy(a) : to_block_sparse<float>(level.matrix);
       level.smoother = make_chebyshev_smoother(level.single.blocks, smoother);

@@ -161,8 +161,8 @@ class MultigridPreconditioner final : public Preconditioner {
   const SparseMatrix& coarse_operator(std::size_t level) const;
 
  private:
-  friend MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume,
-                                                 const MultigridOptions& options);
+  friend MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator,
+                                              const LinkedVolume& volume, const MultigridOptions& options);
   template <typename Scalar>
   void cycle(std::size_t level) const;
   template <typename Scalar, typename Matrix>
@@ -184,6 +184,17 @@ MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, cons
                                         const MultigridOptions& options = {});
 /// The same from scalar CSR (compressed, RowMajor; InputError otherwise).
 MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolume& volume, const MultigridOptions& options = {});
+/// The levels of `a` whose fine level applies `fine` (the same matrix without its values: the
+/// dynamic step's corotated system, fem/corotated_system_operator.hpp; referenced, it must
+/// outlive the use) from the start, as after use_fine_operator: `a` serves the Galerkin product
+/// of the first coarse level only, and no copy of it is kept (the float copy alone is 50 MB at
+/// 44k cells). The fine level has no weak pieces (they need its rows; the step's iterations do
+/// not), so after a cut the build skips their search and factorization, which took 150 ms of a
+/// 44k tube's rebuild. A hierarchy of one level keeps a's factorization and does not apply
+/// `fine` (uses_fine_operator() false). InputError as build_multigrid, and when `fine`'s rows
+/// or fixed dofs differ from a's.
+MultigridPreconditioner build_multigrid_for_operator(const VertexOperator& fine, const BlockSparseMatrix<double>& a,
+                                                     const LinkedVolume& volume, const MultigridOptions& options = {});
 
 /// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
 void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
