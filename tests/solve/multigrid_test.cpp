@@ -475,6 +475,54 @@ TEST(Multigrid, AfterACutTheKeptLevelsAreTheGalerkinOperatorsOfTheNewMatrix) {
   EXPECT_LT((y - z).norm(), 1e-7 * z.norm());
 }
 
+// After a cut the fine smoother's bound lambda_max(D^-1 A) is re-estimated from the last power
+// iteration's vector (a third of the products of a cold estimate): it must still bound the true
+// largest eigenvalue, stay close to it, and a warm start that does not fit falls back to cold.
+TEST(Multigrid, AfterACutTheSmootherBoundStartsWarmAndStillBoundsTheSpectrum) {
+  MultigridOptions options;
+  options.coarsest_max_dofs = 100;
+  TissueModel model = test::make_box({32, 16, 4}, 1.0);
+  const test::LinearSystem uncut = test::clamped_system(model, test::Clamp::both_ends);
+  MultigridPreconditioner m = build_multigrid(uncut.a, model.volume, options);
+  const double before_cut = m.levels()[0].smoother.lambda_max;
+  ASSERT_EQ(m.levels()[0].smoother.lambda_vector.size(), uncut.a.rows());
+
+  const VertexId before = model.volume.vertex_count();
+  std::vector<CellFace> faces;
+  for (CellId c = 0; c < model.volume.cell_count(); ++c) {
+    const Vec3i& v = model.volume.cell_voxel(c);
+    if (v.x() == 15 && v.y() < 10) faces.push_back({c, 1});
+  }
+  const CutReport report = model.volume.cut_links(faces);
+  const VertexId after = model.volume.vertex_count();
+  const std::vector<VertexId> origins = origins_of_new_vertices(report, before, after);
+  const test::LinearSystem cut = test::clamped_system(model, test::Clamp::both_ends);
+  const BlockSparseMatrix<double> cut_blocks = to_block_sparse<double>(cut.a);
+  m.replace_fine_level(cut_blocks, origins, options.smoother);
+  const ChebyshevSmoother& warm = m.levels()[0].smoother;
+  EXPECT_EQ(warm.lambda_vector.size(), cut.a.rows());
+  EXPECT_NEAR(warm.lambda_vector.norm(), 1.0, 1e-12);
+
+  // The spectrum's top by a long power iteration, without the safety factor.
+  ChebyshevOptions exact = options.smoother;
+  exact.power_iterations = 400;
+  exact.lambda_safety_factor = 1.0;
+  const double largest = make_chebyshev_smoother(cut_blocks, exact).lambda_max;
+  const double cold = make_chebyshev_smoother(cut_blocks, options.smoother).lambda_max;
+  std::printf("lambda_max(D^-1 A) after the cut %.4f (400 iterations); its bound %.4f before the cut, %.4f warm (%d iterations), "
+              "%.4f cold (%d)\n",
+              largest, before_cut, warm.lambda_max, options.smoother.warm_power_iterations, cold, options.smoother.power_iterations);
+  EXPECT_GE(warm.lambda_max, largest);
+  EXPECT_GE(warm.lambda_max, before_cut);  // never lowered by the short iteration
+  EXPECT_LE(warm.lambda_max, 1.2 * largest);
+  EXPECT_NEAR(warm.lambda_max, cold, 0.05 * cold);
+
+  // A vector of another size is no warm start: the estimate is the cold one, bit for bit.
+  const std::vector<VertexId> one_too_many(origins.size() + 1, 0);
+  const ChebyshevSmoother unfit = make_chebyshev_smoother(cut_blocks, options.smoother, ChebyshevWarmStart{&warm, &one_too_many});
+  EXPECT_EQ(unfit.lambda_max, cold);
+}
+
 TEST(Multigrid, ReplacingTheFineLevelRefusesOriginsOutsideTheOldLevel) {
   MultigridOptions options;
   options.coarsest_max_dofs = 100;

@@ -43,17 +43,44 @@ const std::vector<Mat3>& ChebyshevSmoother::inverse_blocks<double>() const {
 
 namespace {
 
-/// lambda_max of D^-1 A by power iteration from a fixed, non-special start vector (deterministic),
-/// enlarged by the safety factor.
+/// The warm start's vector on the new level (copies take their origin's entries); empty when
+/// there is none that fits `rows`.
+Eigen::VectorXd warm_vector(const ChebyshevWarmStart& warm, Eigen::Index rows) {
+  if (warm.before == nullptr || warm.origin_of_new == nullptr) return {};
+  const Eigen::VectorXd& old = warm.before->lambda_vector;
+  const auto copies = static_cast<Eigen::Index>(warm.origin_of_new->size());
+  if (old.size() == 0 || old.size() + 3 * copies != rows) return {};
+  Eigen::VectorXd x(rows);
+  x.head(old.size()) = old;
+  for (Eigen::Index i = 0; i < copies; ++i) {
+    const VertexId origin = (*warm.origin_of_new)[static_cast<std::size_t>(i)];
+    if (origin < 0 || 3 * static_cast<Eigen::Index>(origin) >= old.size()) return {};
+    x.segment<3>(old.size() + 3 * i) = old.segment<3>(3 * static_cast<Eigen::Index>(origin));
+  }
+  return x;
+}
+
+/// Sets s.lambda_max to lambda_max of D^-1 A by power iteration, enlarged by the safety factor,
+/// and s.lambda_vector to the iteration's last vector: from the warm start's vector when there
+/// is one (warm_power_iterations, and at least the old estimate), else from a fixed, non-special
+/// start vector (deterministic).
 template <typename Scalar, typename Matrix>
-double estimate_lambda_max(const Matrix& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse, const ChebyshevOptions& options) {
+void estimate_lambda_max(const Matrix& a, const ChebyshevOptions& options, const ChebyshevWarmStart& warm, ChebyshevSmoother& s) {
   using VectorS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  const auto& inverse = s.inverse_blocks<Scalar>();
   const Eigen::Index n = a.rows();
   VectorS x(n), z(n);
   const VectorS zero = VectorS::Zero(n);
-  for (Eigen::Index i = 0; i < n; ++i) x[i] = static_cast<Scalar>(1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i)));
+  const Eigen::VectorXd start = warm_vector(warm, n);
+  const bool warmed = start.size() == n && start.allFinite() && start.norm() > 0;
+  if (warmed) {
+    x = start.cast<Scalar>();
+  } else {
+    for (Eigen::Index i = 0; i < n; ++i) x[i] = static_cast<Scalar>(1.0 + 0.5 * std::sin(0.7 * static_cast<double>(i)));
+  }
   double estimate = 1;
-  for (int k = 0; k < options.power_iterations; ++k) {
+  const int iterations = warmed ? options.warm_power_iterations : options.power_iterations;
+  for (int k = 0; k < iterations; ++k) {
     const double norm = static_cast<double>(x.norm());
     if (!(norm > 0) || !std::isfinite(norm)) break;
     x /= static_cast<Scalar>(norm);
@@ -64,33 +91,44 @@ double estimate_lambda_max(const Matrix& a, const std::vector<Eigen::Matrix<Scal
   }
   const double growth = static_cast<double>(x.norm());
   if (std::isfinite(growth) && growth > estimate) estimate = growth;
-  return options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+  s.lambda_max = options.lambda_safety_factor * (std::isfinite(estimate) && estimate > 0 ? estimate : 1.0);
+  if (warmed) s.lambda_max = std::max(s.lambda_max, warm.before->lambda_max);
+  s.lambda_vector = x.template cast<double>();
+  const double length = s.lambda_vector.norm();
+  if (length > 0 && std::isfinite(length)) s.lambda_vector /= length;
+  else s.lambda_vector.resize(0);
 }
 
 }  // namespace
 
 template <typename Scalar>
-ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options) {
+ChebyshevSmoother make_chebyshev_smoother(const BlockSparseMatrix<Scalar>& a, const ChebyshevOptions& options,
+                                          const ChebyshevWarmStart& warm) {
   ChebyshevSmoother s;
   s.options = options;
   s.set_inverse_diagonal(inverse_diagonal_blocks(a));
-  s.lambda_max = estimate_lambda_max<Scalar>(a, s.inverse_blocks<Scalar>(), options);
+  estimate_lambda_max<Scalar>(a, options, warm, s);
   return s;
 }
 
 template <typename Scalar>
-ChebyshevSmoother make_chebyshev_smoother(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const ChebyshevOptions& options) {
+ChebyshevSmoother make_chebyshev_smoother(const VertexOperator& a, std::vector<Mat3> inverse_diagonal, const ChebyshevOptions& options,
+                                          const ChebyshevWarmStart& warm) {
   ChebyshevSmoother s;
   s.options = options;
   s.set_inverse_diagonal(std::move(inverse_diagonal));
-  s.lambda_max = estimate_lambda_max<Scalar>(a, s.inverse_blocks<Scalar>(), options);
+  estimate_lambda_max<Scalar>(a, options, warm, s);
   return s;
 }
 
-template ChebyshevSmoother make_chebyshev_smoother<float>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&);
-template ChebyshevSmoother make_chebyshev_smoother<double>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&);
-template ChebyshevSmoother make_chebyshev_smoother<float>(const BlockSparseMatrix<float>&, const ChebyshevOptions&);
-template ChebyshevSmoother make_chebyshev_smoother<double>(const BlockSparseMatrix<double>&, const ChebyshevOptions&);
+template ChebyshevSmoother make_chebyshev_smoother<float>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&,
+                                                          const ChebyshevWarmStart&);
+template ChebyshevSmoother make_chebyshev_smoother<double>(const VertexOperator&, std::vector<Mat3>, const ChebyshevOptions&,
+                                                           const ChebyshevWarmStart&);
+template ChebyshevSmoother make_chebyshev_smoother<float>(const BlockSparseMatrix<float>&, const ChebyshevOptions&,
+                                                          const ChebyshevWarmStart&);
+template ChebyshevSmoother make_chebyshev_smoother<double>(const BlockSparseMatrix<double>&, const ChebyshevOptions&,
+                                                           const ChebyshevWarmStart&);
 
 void ChebyshevSmoother::set_inverse_diagonal(std::vector<Mat3> inverse) {
   inverse_diagonal = std::move(inverse);

@@ -313,11 +313,13 @@ void MultigridPreconditioner::replace_fine_level(const VertexOperator& a, std::v
   fine.weak_pieces = WeakPieceSolves();  // found on the old cells; the next rebuild finds the new ones
   fine.single.blocks = BlockSparseMatrix<float>();  // the old pattern: of no use to the new level
   fine.twin.blocks = BlockSparseMatrix<double>();
+  const ChebyshevSmoother before = std::move(fine.smoother);
+  const ChebyshevWarmStart warm{&before, &origin_of_new};
   if (precision_ == CyclePrecision::single_precision) {
-    fine.smoother = make_chebyshev_smoother<float>(a, std::move(inverse_diagonal), smoother);
+    fine.smoother = make_chebyshev_smoother<float>(a, std::move(inverse_diagonal), smoother, warm);
     allocate_cycle<float>();
   } else {
-    fine.smoother = make_chebyshev_smoother<double>(a, std::move(inverse_diagonal), smoother);
+    fine.smoother = make_chebyshev_smoother<double>(a, std::move(inverse_diagonal), smoother, warm);
     allocate_cycle<double>();
   }
 }
@@ -329,13 +331,15 @@ void MultigridPreconditioner::replace_fine_level(const BlockSparseMatrix<double>
   fine_operator_ = nullptr;
   fine.fixed = identity_rows(a);
   fine.weak_pieces = WeakPieceSolves();  // found on the old cells; the next rebuild finds the new ones
+  const ChebyshevSmoother before = std::move(fine.smoother);
+  const ChebyshevWarmStart warm{&before, &origin_of_new};
   if (precision_ == CyclePrecision::single_precision) {
     fine.single.blocks = single_precision_copy(a);
-    fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother);
+    fine.smoother = make_chebyshev_smoother(fine.single.blocks, smoother, warm);
     allocate_cycle<float>();
   } else {
     fine.twin.blocks = a;
-    fine.smoother = make_chebyshev_smoother(fine.twin.blocks, smoother);
+    fine.smoother = make_chebyshev_smoother(fine.twin.blocks, smoother, warm);
     allocate_cycle<double>();
   }
 }
