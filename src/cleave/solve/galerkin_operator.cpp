@@ -29,11 +29,16 @@ class BlockRowAccumulator {
     }
     return blocks_[static_cast<std::size_t>(s)].second;
   }
-  /// The row sorted by column; the accumulator is empty afterwards.
-  std::vector<std::pair<VertexId, Mat3>> take_sorted() {
+  /// The row in the order its columns were first met; the accumulator is empty afterwards.
+  std::vector<std::pair<VertexId, Mat3>> take() {
     for (const auto& b : blocks_) slot_[static_cast<std::size_t>(b.first)] = -1;
     std::vector<std::pair<VertexId, Mat3>> row = std::move(blocks_);
     blocks_.clear();
+    return row;
+  }
+  /// The row sorted by column; the accumulator is empty afterwards.
+  std::vector<std::pair<VertexId, Mat3>> take_sorted() {
+    std::vector<std::pair<VertexId, Mat3>> row = take();
     std::sort(row.begin(), row.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
     return row;
   }
@@ -159,7 +164,7 @@ SparseMatrix galerkin_operator(const BlockSparseMatrix<double>& blocks, const st
           acc.at(entry.vertex) += entry.weight * block;
         }
       }
-      ap[i] = acc.take_sorted();
+      ap[i] = acc.take();  // A P's rows are only summed into P^T (A P): no order needed
     }
   });
 
