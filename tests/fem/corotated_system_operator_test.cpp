@@ -370,6 +370,17 @@ TEST(CorotatedSystemOperator, MultigridBuiltForTheOperatorCyclesAsTheOneSwitched
     EXPECT_EQ(std::string(e.what()), fmt::format("multigrid: the fine operator has {} rows and {} fixed flags; its assembled matrix has {} rows",
                                                  a.rows(), a.rows(), a.rows() - 3));
   }
+  // The solver refuses the same before it drops anything: its levels still solve.
+  try {
+    (void)solver->setup_operator(op, too_small, volume);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()),
+              fmt::format("multigrid: the block copy of the operator has {} rows; the operator has {}", a.rows() - 3, a.rows()));
+  }
+  x.setZero();
+  EXPECT_TRUE(solver->solve(r, x).converged);
+  EXPECT_LT((x - expected).norm(), 1e-8 * expected.norm());
 }
 
 // A multigrid set up for one matrix and then given a very different one as an operator (turned

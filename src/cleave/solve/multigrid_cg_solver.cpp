@@ -104,6 +104,7 @@ class MultigridCgSolver final : public LinearSolver {
   }
 
   bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology) override {
+    // Checked before anything is dropped: a refused set-up leaves the solver as it was.
     if (blocks.rows() != a.rows())
       throw InputError(fmt::format("multigrid: the block copy of the operator has {} rows; the operator has {}", blocks.rows(), a.rows()));
     preconditioner_ = MultigridPreconditioner();  // the old levels go before the new ones are built

@@ -191,8 +191,8 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
 /// 44k cells). The fine level has no weak pieces (they need its rows; the step's iterations do
 /// not), so after a cut the build skips their search and factorization, which took 150 ms of a
 /// 44k tube's rebuild. A hierarchy of one level keeps a's factorization and does not apply
-/// `fine` (uses_fine_operator() false). InputError as build_multigrid, and when `fine`'s rows
-/// or fixed dofs differ from a's.
+/// `fine` (uses_fine_operator() false). The fine level's fixed dofs are `fine`'s. InputError as
+/// build_multigrid, and when `fine`'s rows or fixed flags are not as many as a's rows.
 MultigridPreconditioner build_multigrid_for_operator(const VertexOperator& fine, const BlockSparseMatrix<double>& a,
                                                      const LinkedVolume& volume, const MultigridOptions& options = {});
 
