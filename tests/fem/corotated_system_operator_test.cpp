@@ -340,6 +340,17 @@ TEST(CorotatedSystemOperator, MultigridBuiltForTheOperatorCyclesAsTheOneSwitched
   switched.apply(r, z_switched);
   built.apply(r, z_built);
   EXPECT_LT(relative_difference(z_built, z_switched), 1e-5);
+  // A rebuild continues the fine smoother's estimate of the hierarchy it replaces: closer to the
+  // spectrum's top than the cold start, and never below the old bound.
+  ChebyshevOptions exact = options.smoother;
+  exact.power_iterations = 400;
+  const double top = make_chebyshev_smoother<double>(op, op.inverse_diagonal_blocks(), exact).lambda_max;
+  const std::vector<VertexId> no_copies;
+  const MultigridPreconditioner rebuilt =
+      build_multigrid_for_operator(op, blocks, volume, options, ChebyshevWarmStart{&built.levels()[0].smoother, &no_copies});
+  const double cold = built.levels()[0].smoother.lambda_max, warm = rebuilt.levels()[0].smoother.lambda_max;
+  EXPECT_GE(warm, cold);
+  EXPECT_LT(std::abs(warm - top), std::abs(cold - top));
 
   SolveSettings settings;
   settings.relative_tolerance = 1e-10;

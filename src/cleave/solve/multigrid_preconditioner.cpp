@@ -129,25 +129,26 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
   return build_multigrid(to_block_sparse<double>(a), volume, options);
 }
 
-MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator, const LinkedVolume& volume,
-                                     const MultigridOptions& options);
+MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator,
+                                     const ChebyshevWarmStart& fine_warm, const LinkedVolume& volume, const MultigridOptions& options);
 
 MultigridPreconditioner build_multigrid(const BlockSparseMatrix<double>& a, const LinkedVolume& volume, const MultigridOptions& options) {
-  return build_levels(a, nullptr, volume, options);
+  return build_levels(a, nullptr, {}, volume, options);
 }
 
 MultigridPreconditioner build_multigrid_for_operator(const VertexOperator& fine, const BlockSparseMatrix<double>& a,
-                                                     const LinkedVolume& volume, const MultigridOptions& options) {
+                                                     const LinkedVolume& volume, const MultigridOptions& options,
+                                                     const ChebyshevWarmStart& fine_warm) {
   if (fine.rows() != a.rows() || fine.fixed_dofs().size() != static_cast<std::size_t>(a.rows()))
     throw InputError(fmt::format("multigrid: the fine operator has {} rows and {} fixed flags; its assembled matrix has {} rows",
                                  fine.rows(), fine.fixed_dofs().size(), a.rows()));
-  return build_levels(a, &fine, volume, options);
+  return build_levels(a, &fine, fine_warm, volume, options);
 }
 
-/// build_multigrid, with the fine level applied by `fine_operator` when it is given (see
-/// build_multigrid_for_operator).
-MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator, const LinkedVolume& volume,
-                                     const MultigridOptions& options) {
+/// build_multigrid, with the fine level applied by `fine_operator` when it is given, its smoother's
+/// estimate continued from `fine_warm` (see build_multigrid_for_operator).
+MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator,
+                                     const ChebyshevWarmStart& fine_warm, const LinkedVolume& volume, const MultigridOptions& options) {
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (a.rows() != dofs)
     throw InputError(fmt::format("multigrid: matrix has {} rows; expected {} (3 dofs per vertex of the linked volume)", a.rows(), dofs));
@@ -210,9 +211,10 @@ MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const V
     if (l > 0) smoother.degree = options.coarse_degree;
     if (l == 0 && apply_fine_operator) {
       m.fine_operator_ = fine_operator;
-      level.smoother = m.precision_ == CyclePrecision::single_precision
-                           ? make_chebyshev_smoother<float>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother)
-                           : make_chebyshev_smoother<double>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother);
+      level.smoother =
+          m.precision_ == CyclePrecision::single_precision
+              ? make_chebyshev_smoother<float>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother, fine_warm)
+              : make_chebyshev_smoother<double>(*fine_operator, fine_operator->inverse_diagonal_blocks(), smoother, fine_warm);
       continue;
     }
     if (m.precision_ == CyclePrecision::single_precision) {

@@ -162,7 +162,8 @@ class MultigridPreconditioner final : public Preconditioner {
 
  private:
   friend MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const VertexOperator* fine_operator,
-                                              const LinkedVolume& volume, const MultigridOptions& options);
+                                              const ChebyshevWarmStart& fine_warm, const LinkedVolume& volume,
+                                              const MultigridOptions& options);
   template <typename Scalar>
   void cycle(std::size_t level) const;
   template <typename Scalar, typename Matrix>
@@ -191,10 +192,13 @@ MultigridPreconditioner build_multigrid(const SparseMatrix& a, const LinkedVolum
 /// 44k cells). The fine level has no weak pieces (they need its rows; the step's iterations do
 /// not), so after a cut the build skips their search and factorization, which took 150 ms of a
 /// 44k tube's rebuild. A hierarchy of one level keeps a's factorization and does not apply
-/// `fine` (uses_fine_operator() false). The fine level's fixed dofs are `fine`'s. InputError as
+/// `fine` (uses_fine_operator() false). The fine level's fixed dofs are `fine`'s. `fine_warm`: the
+/// fine smoother of the hierarchy this one replaces, whose lambda_max estimate the new one
+/// continues (a rebuild of the same topology with new values; ChebyshevWarmStart). InputError as
 /// build_multigrid, and when `fine`'s rows or fixed flags are not as many as a's rows.
 MultigridPreconditioner build_multigrid_for_operator(const VertexOperator& fine, const BlockSparseMatrix<double>& a,
-                                                     const LinkedVolume& volume, const MultigridOptions& options = {});
+                                                     const LinkedVolume& volume, const MultigridOptions& options = {},
+                                                     const ChebyshevWarmStart& fine_warm = {});
 
 /// x_fine += P x_coarse on free fine dofs (fixed dofs are not moved).
 void prolongate_add(const Prolongation& p, const std::vector<std::uint8_t>& fine_fixed, const Vector& coarse, Vector& fine);
