@@ -217,7 +217,7 @@ void Dynamics::assemble_system(double c_stiff, double c_stress, double c_mass) {
   });
 }
 
-void Dynamics::hand_system_to_solver(double c_stiff, double c_stress, double c_mass) {
+void Dynamics::hand_system_to_solver(double c_mass) {
   // Same pattern and mass term: the solver keeps its structure. A changed time step changes the
   // mass term c_m M, which stale multigrid levels would miss (many more iterations): set up.
   // After a cut, the multigrid keeps its coarse levels (exactly Galerkin for the new matrix:
@@ -226,10 +226,8 @@ void Dynamics::hand_system_to_solver(double c_stiff, double c_stress, double c_m
   const bool keep = solver_ready_ && solver_mass_factor_ == c_mass && origins_known();
   const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
   bool set_up_with_operator = false;
-  if (!taken_as_blocks && settings_.matrix_free) {
-    system_operator_.set_state(rotations_, tension_kPa_, c_stiff, c_stress, c_mass, mass_, fixed_);
+  if (!taken_as_blocks && settings_.matrix_free)  // step() set the operator's state
     set_up_with_operator = solver_->setup_operator(system_operator_, system_blocks_, model_.volume);
-  }
   if (set_up_with_operator) {
     solver_ready_ = true;
     solver_mass_factor_ = c_mass;
@@ -262,12 +260,11 @@ bool Dynamics::origins_known() const {
          static_cast<VertexId>(origin_of_new_.size()) == vertices - solver_vertices_;
 }
 
-bool Dynamics::hand_operator_to_solver(double c_stiff, double c_stress, double c_mass) {
+bool Dynamics::hand_operator_to_solver(double c_mass) {
   if (!solver_ready_ || solver_mass_factor_ != c_mass) return false;
   const VertexId vertices = model_.volume.vertex_count();
   const bool cut_since = vertices != solver_vertices_ || !origin_of_new_.empty();
   if (cut_since && !origins_known()) return false;
-  system_operator_.set_state(rotations_, tension_kPa_, c_stiff, c_stress, c_mass, mass_, fixed_);
   const bool taken = cut_since ? solver_->update_topology_operator(system_operator_, model_.volume, origin_of_new_)
                                : solver_->update_operator(system_operator_, model_.volume);
   if (!taken) return false;
@@ -343,7 +340,10 @@ SolveReport Dynamics::step(double dt) {
     du.setZero();
     report.converged = true;
   } else {
-    if (!(settings_.matrix_free && hand_operator_to_solver(c_stiff, w, c_mass))) {
+    // The system applied cell by cell: its state once per step, for the operator's update or a
+    // rebuild from the assembled blocks alike.
+    if (settings_.matrix_free) system_operator_.set_state(rotations_, tension_kPa_, c_stiff, w, c_mass, mass_, fixed_);
+    if (!(settings_.matrix_free && hand_operator_to_solver(c_mass))) {
       ensure_pattern();
       assemble_system(c_stiff, w, c_mass);
       if (any_fixed_) {
@@ -352,7 +352,7 @@ SolveReport Dynamics::step(double dt) {
         held.value_mm = Vector::Zero(u_.size());
         eliminate_fixed_dofs(system_blocks_, rhs, held);
       }
-      hand_system_to_solver(c_stiff, w, c_mass);
+      hand_system_to_solver(c_mass);
     }
     report = solver_->solve(rhs, du);
     require_converged(report, solver_->name(), settings_.solve, fmt::format("dynamic step at t = {:.6g} s", time_s_));

@@ -139,13 +139,13 @@ class Dynamics {
   /// no scaling pass); K_sigma from tension_kPa_.
   void assemble_system(double c_stiff, double c_stress, double c_mass);
   /// Gives the solver the assembled system (mass term c_mass): block values where it takes
-  /// them; else, for a matrix-free set-up, system_operator_ with the blocks to build from (the
-  /// multigrid's rebuilds: no scalar copy, no fine-level copy, the step applied cell by cell);
-  /// else system_.
-  void hand_system_to_solver(double c_stiff, double c_stress, double c_mass);
-  /// Gives the solver the system as system_operator_ (no assembly) where it takes it: the
-  /// topology and the mass term are those it was last given. false: assemble.
-  bool hand_operator_to_solver(double c_stiff, double c_stress, double c_mass);
+  /// them; else, for a matrix-free set-up, system_operator_ (its state set) with the blocks to
+  /// build from (the multigrid's rebuilds: no scalar copy, no fine-level copy, the step applied
+  /// cell by cell); else system_.
+  void hand_system_to_solver(double c_mass);
+  /// Gives the solver the system as system_operator_ (its state set; no assembly) where it takes
+  /// it: the topology and the mass term are those it was last given. false: assemble.
+  bool hand_operator_to_solver(double c_mass);
   void compute_acceleration();
 
   const TissueModel& model_;
