@@ -18,82 +18,23 @@ void vertex_neighbours(const LinkedVolume& volume, VertexId v, std::vector<Verte
 
 namespace {
 
-/// Shared by the fresh and the incremental pattern: `previous` is null for a fresh one.
-SparseMatrix build_pattern(const LinkedVolume& volume, const SparseMatrix* previous,
-                           const std::vector<std::uint8_t>* affected) {
+/// The block rows and columns of the current topology: rows of vertices with copied(v) take the
+/// `width(v)` block columns `column_of(v, k)` of an earlier pattern (unchanged by the cuts since),
+/// the others their neighbours found afresh. Shared by the block and the scalar patterns.
+template <typename Copied, typename Width, typename ColumnOf>
+void build_block_rows(const LinkedVolume& volume, const Copied& copied, const Width& width, const ColumnOf& column_of,
+                      std::vector<std::int32_t>& row_start, std::vector<std::int32_t>& column) {
   const VertexId n = volume.vertex_count();
   volume.vertex_cells();  // build the lazy cache before the parallel loops
-  const auto copied = [&](VertexId v) {
-    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && 3 * v < previous->rows();
-  };
-  std::vector<std::int64_t> row_width(static_cast<std::size_t>(n));
-  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
-    std::vector<VertexId> neighbours;
-    for (VertexId v = range.begin(); v != range.end(); ++v) {
-      if (copied(v)) {
-        row_width[static_cast<std::size_t>(v)] = previous->outerIndexPtr()[3 * v + 1] - previous->outerIndexPtr()[3 * v];
-      } else {
-        vertex_neighbours(volume, v, neighbours);
-        row_width[static_cast<std::size_t>(v)] = 3 * static_cast<std::int64_t>(neighbours.size());
-      }
-    }
-  });
-  SparseMatrix m(3 * static_cast<Eigen::Index>(n), 3 * static_cast<Eigen::Index>(n));
-  std::int64_t nnz = 0;
-  for (VertexId v = 0; v < n; ++v) nnz += 3 * row_width[static_cast<std::size_t>(v)];
-  m.resizeNonZeros(static_cast<Eigen::Index>(nnz));
-  auto* outer = m.outerIndexPtr();
-  std::int64_t at = 0;
-  for (VertexId v = 0; v < n; ++v)
-    for (int i = 0; i < 3; ++i) {
-      outer[3 * v + i] = static_cast<SparseMatrix::StorageIndex>(at);
-      at += row_width[static_cast<std::size_t>(v)];
-    }
-  outer[3 * n] = static_cast<SparseMatrix::StorageIndex>(at);
-
-  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
-    std::vector<VertexId> neighbours;
-    for (VertexId v = range.begin(); v != range.end(); ++v) {
-      const auto width = row_width[static_cast<std::size_t>(v)];
-      if (copied(v)) {
-        for (int i = 0; i < 3; ++i) {
-          const auto from = previous->outerIndexPtr()[3 * v + i];
-          std::copy_n(previous->innerIndexPtr() + from, width, m.innerIndexPtr() + outer[3 * v + i]);
-          std::copy_n(previous->valuePtr() + from, width, m.valuePtr() + outer[3 * v + i]);
-        }
-        continue;
-      }
-      vertex_neighbours(volume, v, neighbours);
-      for (int i = 0; i < 3; ++i) {
-        auto* columns = m.innerIndexPtr() + outer[3 * v + i];
-        for (std::size_t k = 0; k < neighbours.size(); ++k)
-          for (int j = 0; j < 3; ++j) columns[3 * k + static_cast<std::size_t>(j)] = 3 * neighbours[k] + j;
-        std::fill_n(m.valuePtr() + outer[3 * v + i], width, 0.0);
-      }
-    }
-  });
-  return m;
-}
-
-/// The block rows and columns of the current topology (values untouched): rows of unaffected
-/// vertices copied from `previous` when given. Shared by the fresh and the incremental pattern.
-void build_block_pattern(const LinkedVolume& volume, const BlockSparseMatrix<double>* previous, const std::vector<std::uint8_t>* affected,
-                         std::vector<std::int32_t>& row_start, std::vector<std::int32_t>& column) {
-  const VertexId n = volume.vertex_count();
-  volume.vertex_cells();  // build the lazy cache before the parallel loops
-  const auto copied = [&](VertexId v) {
-    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && v < previous->block_rows();
-  };
   row_start.assign(static_cast<std::size_t>(n) + 1, 0);
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
     std::vector<VertexId> neighbours;
     for (VertexId v = range.begin(); v != range.end(); ++v) {
-      const auto row = static_cast<std::size_t>(v);
       if (copied(v)) {
-        row_start[row + 1] = previous->row_start[row + 1] - previous->row_start[row];
+        row_start[static_cast<std::size_t>(v) + 1] = width(v);
       } else {
         vertex_neighbours(volume, v, neighbours);
-        row_start[row + 1] = static_cast<std::int32_t>(neighbours.size());
+        row_start[static_cast<std::size_t>(v) + 1] = static_cast<std::int32_t>(neighbours.size());
       }
     }
   });
@@ -102,17 +43,76 @@ void build_block_pattern(const LinkedVolume& volume, const BlockSparseMatrix<dou
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
     std::vector<VertexId> neighbours;
     for (VertexId v = range.begin(); v != range.end(); ++v) {
-      const auto row = static_cast<std::size_t>(v);
-      auto* columns = column.data() + row_start[row];
+      auto* columns = column.data() + row_start[static_cast<std::size_t>(v)];
       if (copied(v)) {
-        const auto from = previous->column.begin() + previous->row_start[row];
-        std::copy(from, previous->column.begin() + previous->row_start[row + 1], columns);
+        for (std::int32_t k = 0; k < width(v); ++k) columns[k] = column_of(v, k);
         continue;
       }
       vertex_neighbours(volume, v, neighbours);
       std::copy(neighbours.begin(), neighbours.end(), columns);
     }
   });
+}
+
+/// The scalar pattern (3 rows per block row, every entry of every block), zero except the rows
+/// of unaffected vertices, whose values are copied from `previous`. `previous` is null for a
+/// fresh one.
+SparseMatrix build_pattern(const LinkedVolume& volume, const SparseMatrix* previous, const std::vector<std::uint8_t>* affected) {
+  const auto copied = [&](VertexId v) {
+    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && 3 * v < previous->rows();
+  };
+  const auto width = [&](VertexId v) {
+    return static_cast<std::int32_t>((previous->outerIndexPtr()[3 * v + 1] - previous->outerIndexPtr()[3 * v]) / 3);
+  };
+  const auto column_of = [&](VertexId v, std::int32_t k) {
+    return static_cast<std::int32_t>(previous->innerIndexPtr()[previous->outerIndexPtr()[3 * v] + 3 * k] / 3);
+  };
+  std::vector<std::int32_t> row_start, column;
+  build_block_rows(volume, copied, width, column_of, row_start, column);
+
+  const VertexId n = volume.vertex_count();
+  const auto entries = static_cast<Eigen::Index>(9 * static_cast<std::int64_t>(column.size()));
+  SparseMatrix m(3 * static_cast<Eigen::Index>(n), 3 * static_cast<Eigen::Index>(n));
+  m.resizeNonZeros(entries);
+  auto* outer = m.outerIndexPtr();
+  for (VertexId v = 0; v < n; ++v) {
+    const auto first = static_cast<std::int64_t>(row_start[static_cast<std::size_t>(v)]);
+    const auto blocks = static_cast<std::int64_t>(row_start[static_cast<std::size_t>(v) + 1]) - first;
+    for (int i = 0; i < 3; ++i) outer[3 * v + i] = static_cast<SparseMatrix::StorageIndex>(9 * first + 3 * i * blocks);
+  }
+  outer[3 * n] = static_cast<SparseMatrix::StorageIndex>(entries);
+
+  tbb::parallel_for(tbb::blocked_range<VertexId>(0, n), [&](const tbb::blocked_range<VertexId>& range) {
+    for (VertexId v = range.begin(); v != range.end(); ++v) {
+      const auto first = static_cast<std::size_t>(row_start[static_cast<std::size_t>(v)]);
+      const auto blocks = static_cast<std::size_t>(row_start[static_cast<std::size_t>(v) + 1]) - first;
+      const bool keep_values = copied(v);
+      for (int i = 0; i < 3; ++i) {
+        const auto at = outer[3 * v + i];
+        auto* columns = m.innerIndexPtr() + at;
+        for (std::size_t k = 0; k < blocks; ++k)
+          for (int j = 0; j < 3; ++j) columns[3 * k + static_cast<std::size_t>(j)] = 3 * column[first + k] + j;
+        if (keep_values) std::copy_n(previous->valuePtr() + previous->outerIndexPtr()[3 * v + i], 3 * blocks, m.valuePtr() + at);
+        else std::fill_n(m.valuePtr() + at, 3 * blocks, 0.0);
+      }
+    }
+  });
+  return m;
+}
+
+/// The block pattern: rows of unaffected vertices copied from `previous` when given.
+void build_block_pattern(const LinkedVolume& volume, const BlockSparseMatrix<double>* previous, const std::vector<std::uint8_t>* affected,
+                         std::vector<std::int32_t>& row_start, std::vector<std::int32_t>& column) {
+  const auto copied = [&](VertexId v) {
+    return previous != nullptr && (*affected)[static_cast<std::size_t>(v)] == 0 && v < previous->block_rows();
+  };
+  const auto width = [&](VertexId v) {
+    return previous->row_start[static_cast<std::size_t>(v) + 1] - previous->row_start[static_cast<std::size_t>(v)];
+  };
+  const auto column_of = [&](VertexId v, std::int32_t k) {
+    return previous->column[static_cast<std::size_t>(previous->row_start[static_cast<std::size_t>(v)] + k)];
+  };
+  build_block_rows(volume, copied, width, column_of, row_start, column);
 }
 
 }  // namespace
