@@ -71,8 +71,9 @@ class ChebyshevSmoother {
 };
 
 /// The smoother of a level before cuts divided its vertices (vertex n + i of the new level is a
-/// copy of origin_of_new[i]): the new smoother's lambda_max estimate starts from the old one's
-/// power-iteration vector (copies take their origin's entries) and runs warm_power_iterations;
+/// copy of origin_of_new[i]; no copies: the same vertices, a rebuild for new values): the new
+/// smoother's lambda_max estimate starts from the old one's power-iteration vector (copies take
+/// their origin's entries) and runs warm_power_iterations;
 /// it is kept at least at the old estimate, so too few iterations cannot lower it. Without a
 /// vector of the old size (a smoother made before it kept one), the estimate starts cold.
 struct ChebyshevWarmStart {

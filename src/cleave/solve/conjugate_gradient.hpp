@@ -14,7 +14,8 @@
 // solution in the energy norm. Edge cases: b = 0 gives x = 0 and converged after 0 iterations. A
 // non-finite x on entry is replaced by 0. When the iteration breaks down (non-positive
 // curvature, NaN) or runs out of iterations, x keeps its last finite value (at worst the initial
-// guess) and converged = false: x never holds NaN. Restarts from the true residual when rounding drift fools the recurrence.
+// guess) and converged = false: x never holds NaN. Restarts from the true residual when rounding
+// drift fools the recurrence.
 // With settings.single_precision_products (operators only) each iteration's q = A p is a float
 // product; the initial and the final (true) residual stay in double, so the report never rests
 // on the float products.
