@@ -46,9 +46,7 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   const auto cells = static_cast<std::size_t>(volume.cell_count());
   material_.resize(cells);
   for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
-  VertexCornerSlots slots = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
-  vertex_start_ = std::move(slots.start);
-  vertex_slot_ = std::move(slots.slot);
+  corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
 }
 
@@ -204,13 +202,13 @@ void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const E
                                              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked,
                                              Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const {
   y.resize(x_in.size());
-  const auto vertices = static_cast<VertexId>(vertex_start_.size() - 1);
+  const auto vertices = static_cast<VertexId>(corner_slots_.start.size() - 1);
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<VertexId>& r) {
     for (VertexId v = r.begin(); v < r.end(); ++v) {
       const auto i = 3 * static_cast<Eigen::Index>(v);
       Eigen::Matrix<Scalar, 3, 1> sum = p.mass_term.template segment<3>(i).cwiseProduct(x_masked.template segment<3>(i));
-      for (std::int32_t s = vertex_start_[static_cast<std::size_t>(v)]; s < vertex_start_[static_cast<std::size_t>(v) + 1]; ++s) {
-        const Scalar* slot = p.per_cell.data() + vertex_slot_[static_cast<std::size_t>(s)];
+      for (std::int32_t s = corner_slots_.start[static_cast<std::size_t>(v)]; s < corner_slots_.start[static_cast<std::size_t>(v) + 1]; ++s) {
+        const Scalar* slot = p.per_cell.data() + corner_slots_.slot[static_cast<std::size_t>(s)];
         sum += Eigen::Matrix<Scalar, 3, 1>(slot[0], slot[8], slot[16]);
       }
       y.template segment<3>(i) = sum;
@@ -236,14 +234,14 @@ double CorotatedSystemOperator::stress_coefficient(std::size_t cell, int a, int 
 }
 
 std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
-  const auto vertices = static_cast<std::size_t>(vertex_start_.size() - 1);
+  const auto vertices = static_cast<std::size_t>(corner_slots_.start.size() - 1);
   std::vector<Mat3> out(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, static_cast<std::size_t>(kVerticesPerTask)),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t v = r.begin(); v < r.end(); ++v) {
                         Mat3 block = Mat3::Zero();
-                        for (std::int32_t s = vertex_start_[v]; s < vertex_start_[v + 1]; ++s) {
-                          const auto slot = vertex_slot_[static_cast<std::size_t>(s)];
+                        for (std::int32_t s = corner_slots_.start[v]; s < corner_slots_.start[v + 1]; ++s) {
+                          const auto slot = corner_slots_.slot[static_cast<std::size_t>(s)];
                           const auto c = static_cast<std::size_t>(slot / 24);
                           const int a = slot % 24;
                           const Mat3& rotation = rotations_[c];

@@ -29,6 +29,7 @@
 #include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/grid/linked_volume.hpp"
+#include "cleave/grid/vertex_corner_slots.hpp"
 #include "cleave/solve/vertex_operator.hpp"
 
 namespace cleave {
@@ -45,12 +46,15 @@ class CorotatedSystemOperator final : public VertexOperator {
   void set_state(std::span<const Mat3> rotations, std::span<const Vec6> tension_kPa, double c_stiff, double c_stress,
                  double c_mass, const Vector& mass_kg, const std::vector<std::uint8_t>& fixed);
 
-  Eigen::Index rows() const override { return 3 * static_cast<Eigen::Index>(vertex_start_.size() - 1); }
+  Eigen::Index rows() const override { return 3 * static_cast<Eigen::Index>(corner_slots_.start.size() - 1); }
   void multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const override;
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
   std::vector<Mat3> inverse_diagonal_blocks() const override;
   SparseMatrix assembled_matrix() const override;
   const std::vector<std::uint8_t>& fixed_dofs() const override { return *fixed_; }
+  /// Per vertex, its corners in the topology's cells for 24 values per cell (8 x, 8 y, 8 z): what
+  /// other cell passes over the same topology sum their per-cell values with.
+  const VertexCornerSlots& corner_slots() const { return corner_slots_; }
 
   /// The float product's cell pass in AVX-512, two cells per register
   /// (fem/corotated_cells_avx512.hpp): on by default where the CPU has it. Throws InputError when
@@ -97,8 +101,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   const LinkedVolume* volume_ = nullptr;
   const ElementTable* table_ = nullptr;
   std::vector<std::uint8_t> material_;        ///< per cell: slot in table.per_material
-  std::vector<std::int32_t> vertex_start_{0};  ///< per vertex and one past the last: first slot
-  std::vector<std::int32_t> vertex_slot_;      ///< per slot: 24 c + a (cell c, corner a): its x in per_cell
+  VertexCornerSlots corner_slots_;  ///< per vertex: slots 24 c + a (cell c, corner a), its x in per_cell
   std::span<const Mat3> rotations_;
   bool with_tension_ = false;
   const std::vector<std::uint8_t>* fixed_ = nullptr;

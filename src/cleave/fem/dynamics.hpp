@@ -162,6 +162,7 @@ class Dynamics {
   BlockSparseMatrix<double> system_blocks_;
   VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
   CorotatedSystemOperator system_operator_;  ///< the same system applied cell by cell
+  mutable std::vector<double> force_per_cell_;  ///< internal_forces' per-cell corner forces (kept: no fresh pages per step)
   std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_
   /// The same matrix as scalar CSR (vertex block pattern of the topology), made and filled from
   /// the blocks only when a solver asks for it (CHOLMOD, Eigen's CG, the assembled steps).
