@@ -3,10 +3,13 @@
 // rigid rotations.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <random>
+#include <span>
 
 #include <Eigen/Geometry>
 
+#include "cleave/core/error.hpp"
 #include "cleave/fem/corotation.hpp"
 #include "cleave/fem/dynamics.hpp"
 #include "cleave/fem/lumped_mass.hpp"
@@ -244,6 +247,51 @@ TEST(Dynamics, PolarRotationByNewtonEqualsTheSvdOne) {
     Mat3 inverted = random_rotation();
     inverted.col(1) *= squash;
     EXPECT_EQ(rotation_from_deformation_gradient(inverted), rotation_by_svd(inverted));
+  }
+}
+
+// The polar rotations taken four at a time in SIMD lanes are those of the one-at-a-time Newton
+// iteration to rounding, whatever each lane's neighbours do: tissue strains, stretches to 1:100,
+// identity, and inverted, flat and non-finite gradients (which go to the SVD lane by lane) mixed
+// into the same groups of four, for counts that do not fill the last group. Spans of different
+// sizes are refused by name.
+TEST(Dynamics, PolarRotationsInLanesEqualTheOneAtATimeOnes) {
+  std::mt19937 random(11);
+  std::uniform_real_distribution<double> unit(-1.0, 1.0);
+  std::vector<Mat3> gradients;
+  for (int i = 0; i < 203; ++i) {
+    const Mat3 q(Eigen::AngleAxisd(3.0 * unit(random), Vec3(unit(random), unit(random), unit(random)).normalized()));
+    Mat3 f = Mat3::Identity();
+    switch (i % 7) {
+      case 0: break;  // undeformed: settles at once beside lanes that need more steps
+      case 1: f.col(1) *= -0.2; break;                   // inverted
+      case 2: f(2, 2) = 1e-9; break;                      // nearly flat
+      case 3: f = Mat3::Constant(std::nan("")); break;    // not finite
+      case 4: f.diagonal() = Vec3(1.0, 10.0, 100.0); break;  // 1:100
+      default:
+        for (int e = 0; e < 9; ++e) f(e / 3, e % 3) += 0.1 * unit(random);  // tissue strains
+    }
+    gradients.push_back(q * f);
+  }
+  for (const std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{4}, std::size_t{7}, gradients.size()}) {
+    std::vector<Mat3> rotations(count);
+    rotations_from_deformation_gradients(std::span<const Mat3>(gradients.data(), count), rotations);
+    for (std::size_t i = 0; i < count; ++i) {
+      const Mat3 alone = rotation_from_deformation_gradient(gradients[i]);
+      if (!alone.allFinite()) {
+        EXPECT_FALSE(rotations[i].allFinite()) << "gradient " << i;
+        continue;
+      }
+      EXPECT_LT((rotations[i] - alone).cwiseAbs().maxCoeff(), 1e-14) << "gradient " << i << " of " << count;
+      EXPECT_NEAR(rotations[i].determinant(), 1.0, 1e-13) << "gradient " << i;
+    }
+  }
+  std::vector<Mat3> too_few(2);
+  try {
+    rotations_from_deformation_gradients(gradients, too_few);
+    ADD_FAILURE() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "polar decomposition: 203 deformation gradients but room for 2 rotations");
   }
 }
 

@@ -1,12 +1,16 @@
 #include "cleave/fem/corotation.hpp"
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 #include <Eigen/LU>
+#include <algorithm>
+#include <array>
 #include <cmath>
 #include <Eigen/SVD>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include "cleave/core/error.hpp"
 #include "cleave/fem/hex8_element.hpp"
 
 namespace cleave {
@@ -41,6 +45,78 @@ Mat3 rotation_from_deformation_gradient(const Mat3& f) {
   return rotation_by_svd(f);
 }
 
+namespace {
+
+constexpr int kLanes = 4;  ///< one AVX2 register of doubles
+using Lanes = Eigen::Array<double, kLanes, 1>;
+
+/// `count` (1 to kLanes) gradients' Newton iteration in lanes: entry (i, j) of every lane's X in
+/// x[3 i + j]. A lane whose determinant is not positive and finite, or that has not settled after
+/// kNewtonMaxIterations, is left to rotation_from_deformation_gradient alone.
+void rotations_in_lanes(const Mat3* f, Mat3* rotations, int count) {
+  std::array<Lanes, 9> x;
+  for (int lane = 0; lane < kLanes; ++lane) {
+    const Mat3& source = f[lane < count ? lane : 0];  // spare lanes repeat the first
+    for (int e = 0; e < 9; ++e) x[static_cast<std::size_t>(e)][lane] = source(e / 3, e % 3);
+  }
+  const auto at = [&](int i, int j) -> const Lanes& { return x[static_cast<std::size_t>(3 * i + j)]; };
+  Eigen::Array<bool, kLanes, 1> settled = Eigen::Array<bool, kLanes, 1>::Constant(false);
+  Eigen::Array<bool, kLanes, 1> to_svd = Eigen::Array<bool, kLanes, 1>::Constant(false);
+  for (int lane = count; lane < kLanes; ++lane) settled[lane] = true;
+  for (int k = 0; k < kNewtonMaxIterations && !(settled || to_svd).all(); ++k) {
+    // X^-T = cofactor / det, the cofactor's columns the cross products of X's columns.
+    std::array<Lanes, 9> cofactor;
+    const auto cross_into = [&](int column, int p, int q) {
+      cofactor[static_cast<std::size_t>(0 + column)] = at(1, p) * at(2, q) - at(2, p) * at(1, q);
+      cofactor[static_cast<std::size_t>(3 + column)] = at(2, p) * at(0, q) - at(0, p) * at(2, q);
+      cofactor[static_cast<std::size_t>(6 + column)] = at(0, p) * at(1, q) - at(1, p) * at(0, q);
+    };
+    cross_into(0, 1, 2);
+    cross_into(1, 2, 0);
+    cross_into(2, 0, 1);
+    const Lanes det = at(0, 0) * cofactor[0] + at(1, 0) * cofactor[3] + at(2, 0) * cofactor[6];
+    Lanes cofactor_norm = Lanes::Zero();
+    Lanes x_norm = Lanes::Zero();
+    for (std::size_t e = 0; e < 9; ++e) {
+      cofactor_norm += cofactor[e].square();
+      x_norm += x[e].square();
+    }
+    // Inverted, flat or not finite: the SVD decides (as rotation_from_deformation_gradient).
+    to_svd = to_svd || (!settled && !(det > 0 && det.isFinite()));
+    const Eigen::Array<bool, kLanes, 1> moving = !(settled || to_svd);
+    const Lanes safe_det = moving.select(det, Lanes::Ones());
+    const Lanes g = ((cofactor_norm / moving.select(x_norm, Lanes::Ones())).sqrt() / safe_det).sqrt();
+    const Lanes cofactor_scale = 0.5 / (g * safe_det);
+    const Lanes x_scale = 0.5 * g;
+    Lanes change = Lanes::Zero();
+    for (std::size_t e = 0; e < 9; ++e) {
+      const Lanes next = x_scale * x[e] + cofactor_scale * cofactor[e];
+      change = change.max((next - x[e]).abs());
+      x[e] = moving.select(next, x[e]);
+    }
+    settled = settled || (moving && change < kNewtonSettled);
+  }
+  for (int lane = 0; lane < count; ++lane) {
+    if (!settled[lane]) {
+      rotations[lane] = rotation_by_svd(f[lane]);
+      continue;
+    }
+    for (int e = 0; e < 9; ++e) rotations[lane](e / 3, e % 3) = x[static_cast<std::size_t>(e)][lane];
+  }
+}
+
+}  // namespace
+
+void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::span<Mat3> rotations) {
+  if (gradients.size() != rotations.size())
+    throw InputError(fmt::format("polar decomposition: {} deformation gradients but room for {} rotations", gradients.size(),
+                                 rotations.size()));
+  for (std::size_t i = 0; i < gradients.size(); i += kLanes) {
+    const int count = static_cast<int>(std::min<std::size_t>(kLanes, gradients.size() - i));
+    rotations_in_lanes(gradients.data() + i, rotations.data() + i, count);
+  }
+}
+
 Mat3 rotation_by_svd(const Mat3& f) {
   const Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Mat3 u = svd.matrixU();
@@ -67,9 +143,13 @@ void cell_rotations(const LinkedVolume& volume, const Vector& u, std::vector<Mat
   rotations.resize(static_cast<std::size_t>(volume.cell_count()));
   const double h = volume.grid().cell_size_mm;
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
-    for (CellId c = r.begin(); c != r.end(); ++c)
-      rotations[static_cast<std::size_t>(c)] =
-          rotation_from_deformation_gradient(hex8_center_deformation_gradient(cell_displacement(volume, c, u), h));
+    std::array<Mat3, kLanes> gradients;
+    for (CellId c = r.begin(); c < r.end(); c += kLanes) {
+      const int count = std::min(kLanes, r.end() - c);
+      for (int i = 0; i < count; ++i)
+        gradients[static_cast<std::size_t>(i)] = hex8_center_deformation_gradient(cell_displacement(volume, c + i, u), h);
+      rotations_in_lanes(gradients.data(), rotations.data() + c, count);
+    }
   });
 }
 

@@ -1,6 +1,7 @@
 #pragma once
 // Corotational frames of the cells: the rotation R of each cell from the deformation gradient F
 // at its centre, by polar decomposition F = R S (R proper orthogonal, S symmetric).
+#include <span>
 #include <vector>
 
 #include "cleave/fem/hex8_element.hpp"
@@ -15,6 +16,11 @@ namespace cleave {
 /// converges quadratically to the polar factor in about 4 iterations for tissue strains (2.6x
 /// faster than the SVD); the SVD otherwise, and where Newton does not settle.
 Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
+/// rotation_from_deformation_gradient of each of `gradients` into `rotations` (as many), four at a
+/// time in SIMD lanes (the same Newton iteration, each lane stopping where it settles; lanes that
+/// go to the SVD are taken one by one): the same rotations to rounding, about 3x faster than one at
+/// a time (the cell passes of every dynamic step run it on all cells).
+void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::span<Mat3> rotations);
 /// The same by the SVD alone (the reference the Newton iteration is tested against).
 Mat3 rotation_by_svd(const Mat3& deformation_gradient);
 
