@@ -196,9 +196,10 @@ TEST(CorotatedSystemOperator, RefusesStateThatDoesNotFitItsTopology) {
   }
 }
 
-// The AVX-512 cell pass (two cells per register) computes the portable pass's product: an odd
-// cell count (the last cell alone), neighbours of different materials in one register, a cut,
-// held dofs, with and without tension. Both passes also meet the independently gathered matrix.
+// The AVX-512 cell passes (float: two cells per register; double: one) compute the portable
+// passes' products: an odd cell count (the last cell alone), neighbours of different materials in
+// one register, a cut, held dofs, with and without tension. All also meet the independently
+// gathered matrix.
 TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
   if (!avx512_cell_pass_supported()) GTEST_SKIP() << "this CPU has no AVX-512 F and DQ: only the portable pass runs";
   TissueModel model = test::make_box_model({7, 5, 3}, 1.5, 60.0, 0.42, [](const Vec3i& v) { return Label(v.x() % 3 == 1 ? 2 : 1); },
@@ -228,8 +229,14 @@ TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
     op.set_wide_cell_pass(false);
     op.multiply(x, portable);
     Vector exact;
-    op.multiply(Vector(x.cast<double>()), exact);
+    op.multiply(Vector(x.cast<double>()), exact);  // the portable double pass
+    op.set_wide_cell_pass(true);
+    Vector wide_exact;
+    op.multiply(Vector(x.cast<double>()), wide_exact);
     const double scale = exact.lpNorm<Eigen::Infinity>();
+    // The double passes: the same operations in another order (and the held rows copied alike).
+    EXPECT_LE((wide_exact - exact).lpNorm<Eigen::Infinity>(), 1e-13 * scale);
+    EXPECT_LE((wide_exact - op.assembled_matrix() * Vector(x.cast<double>())).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
     ASSERT_GT(scale, 1.0);
     // Float rounding in another order of the same operations: far below the 3e-6 both meet.
     EXPECT_LE((wide - portable).cast<double>().lpNorm<Eigen::Infinity>(), 1e-6 * scale);

@@ -93,7 +93,57 @@ void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
   _mm512_storeu_ps(to + 32, _mm512_shuffle_f32x4(out[1], out[2], _MM_SHUFFLE(3, 2, 3, 2)));
 }
 
+/// Cell c in double: lanes are its 8 corners.
+void cell_double(const CorotatedCellsInputDouble& in, std::size_t c) {
+  const __m256i offsets =
+      _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.corners + 8 * c)), _mm256_set1_epi32(3));
+  __m512d world[3];
+  for (int j = 0; j < 3; ++j) world[j] = _mm512_i32gather_pd(offsets, in.x + j, 8);
+  const double* r = in.rotation + 9 * c;  // R(i, j) at 3 j + i
+  // Into the cell's frame: d_i = sum_j R_ji x_j.
+  __m512d local[3];
+  for (int i = 0; i < 3; ++i) {
+    local[i] = _mm512_mul_pd(_mm512_set1_pd(r[3 * i + 0]), world[0]);
+    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 1]), world[1], local[i]);
+    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
+  }
+  // f_i = sum_j K_ij d_j + s d_i, column b of each block (and of s) times corner b's value.
+  const double* k = in.stiffness + 9 * 64 * static_cast<std::size_t>(in.material[c]);
+  const double* t = in.tension != nullptr ? in.tension + 6 * c : nullptr;
+  const bool with_tension = t != nullptr && (t[0] != 0 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 0 || t[5] != 0);
+  __m512d f[3] = {_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
+  for (int b = 0; b < 8; ++b) {
+    const __m512i spread = _mm512_set1_epi64(b);
+    __m512d value[3];
+    for (int j = 0; j < 3; ++j) value[j] = _mm512_permutexvar_pd(spread, local[j]);
+    for (int i = 0; i < 3; ++i)
+      for (int j = 0; j < 3; ++j) {
+        const __m512d column = _mm512_loadu_pd(k + 64 * static_cast<std::size_t>(3 * i + j) + 8 * static_cast<std::size_t>(b));
+        f[i] = _mm512_fmadd_pd(column, value[j], f[i]);
+      }
+    if (with_tension) {
+      // Column b of s = sum_q t_q G_q.
+      __m512d s = _mm512_mul_pd(_mm512_set1_pd(t[0]), _mm512_loadu_pd(in.stress_basis + 8 * static_cast<std::size_t>(b)));
+      for (int q = 1; q < 6; ++q)
+        s = _mm512_fmadd_pd(_mm512_set1_pd(t[q]), _mm512_loadu_pd(in.stress_basis + 64 * static_cast<std::size_t>(q) + 8 * static_cast<std::size_t>(b)), s);
+      for (int i = 0; i < 3; ++i) f[i] = _mm512_fmadd_pd(s, value[i], f[i]);
+    }
+  }
+  // Back into the world: out_i = sum_j R_ij f_j.
+  double* to = in.per_cell + 24 * c;
+  for (int i = 0; i < 3; ++i) {
+    __m512d out = _mm512_mul_pd(_mm512_set1_pd(r[i]), f[0]);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[3 + i]), f[1], out);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[6 + i]), f[2], out);
+    _mm512_storeu_pd(to + 8 * i, out);
+  }
+}
+
 }  // namespace
+
+void corotated_cells_avx512(const CorotatedCellsInputDouble& in, std::size_t begin, std::size_t end) {
+  for (std::size_t c = begin; c < end; ++c) cell_double(in, c);
+}
 
 void corotated_cells_avx512(const CorotatedCellsInput& in, std::size_t begin, std::size_t end) {
   std::size_t c = begin;
@@ -110,6 +160,7 @@ namespace cleave {
 const bool kAvx512CellPassCompiled = false;
 
 void corotated_cells_avx512(const CorotatedCellsInput&, std::size_t, std::size_t) {}
+void corotated_cells_avx512(const CorotatedCellsInputDouble&, std::size_t, std::size_t) {}
 
 }  // namespace cleave
 

@@ -154,6 +154,22 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       sum_per_vertex(p, x_in, *x, y);
       return;
     }
+  } else if (wide_cell_pass_ && cells > 0) {
+    static_assert(sizeof(CornerBlocks<double>) == 9 * 64 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(double) &&
+                  sizeof(Eigen::Matrix<double, 6, 1>) == 6 * sizeof(double) && sizeof(Eigen::Matrix<double, 8, 8>) == 64 * sizeof(double));
+    CorotatedCellsInputDouble in;
+    in.x = x->data();
+    in.corners = volume_->cell_vertices(0).data();
+    in.rotation = rotations_.front().data();
+    in.material = material_.data();
+    in.stiffness = p.stiffness_by_component.front().front().data();
+    in.tension = with_tension_ ? p.tension.front().data() : nullptr;
+    in.stress_basis = p.stress_basis.front().data();
+    in.per_cell = p.per_cell.data();
+    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
+                      [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
+    sum_per_vertex(p, x_in, *x, y);
+    return;
   }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) {

@@ -12,7 +12,8 @@
 // set_state (256 B per cell, 11 MB at 44k cells): forming it from t at every product was 40 % of
 // the product's time (1.5 -> 0.9 ms at 44k cells, session 19); the double product still forms it.
 // Where the CPU has AVX-512, the float cell pass takes two cells per 16-float register
-// (fem/corotated_cells_avx512.hpp; 0.83-0.87 of the portable pass's product at 44k cells).
+// (fem/corotated_cells_avx512.hpp; 0.83-0.87 of the portable pass's product at 44k cells), the
+// double pass one cell per 8-double register.
 //
 //   CorotatedSystemOperator op;
 //   op.set_topology(volume, table);                  // after construction and after every cut
@@ -56,7 +57,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   /// other cell passes over the same topology sum their per-cell values with.
   const VertexCornerSlots& corner_slots() const { return corner_slots_; }
 
-  /// The float product's cell pass in AVX-512, two cells per register
+  /// The cell passes in AVX-512 (float: two cells per register; double: one)
   /// (fem/corotated_cells_avx512.hpp): on by default where the CPU has it. Throws InputError when
   /// asked for on a CPU without it. Off: the portable pass (one cell per 8-float register).
   void set_wide_cell_pass(bool on);
