@@ -29,10 +29,11 @@ class BlockRowAccumulator {
     }
     return blocks_[static_cast<std::size_t>(s)].second;
   }
-  /// The row in the order its columns were first met; the accumulator is empty afterwards.
+  /// The row in the order its columns were first met, in a vector of its own size; the
+  /// accumulator is empty afterwards and keeps its capacity (no regrowth per row).
   std::vector<std::pair<VertexId, Mat3>> take() {
     for (const auto& b : blocks_) slot_[static_cast<std::size_t>(b.first)] = -1;
-    std::vector<std::pair<VertexId, Mat3>> row = std::move(blocks_);
+    std::vector<std::pair<VertexId, Mat3>> row(blocks_.begin(), blocks_.end());
     blocks_.clear();
     return row;
   }
@@ -152,12 +153,17 @@ SparseMatrix galerkin_operator(const BlockSparseMatrix<double>& blocks, const st
         ap[i].clear();
         continue;
       }
+      const bool row_all_free = row_free.minCoeff() > 0;
       for (auto k = blocks.row_start[i]; k < blocks.row_start[i + 1]; ++k) {
         const auto j = static_cast<std::size_t>(blocks.column[static_cast<std::size_t>(k)]);
-        const Vec3 column_free(fixed[3 * j] ? 0.0 : 1.0, fixed[3 * j + 1] ? 0.0 : 1.0, fixed[3 * j + 2] ? 0.0 : 1.0);
-        const Mat3 block = row_free.asDiagonal() *
-                           Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(blocks.values.data() + 9 * static_cast<std::size_t>(k)) *
-                           column_free.asDiagonal();
+        const Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>> stored(blocks.values.data() + 9 * static_cast<std::size_t>(k));
+        Mat3 block;
+        if (row_all_free && fixed[3 * j] == 0 && fixed[3 * j + 1] == 0 && fixed[3 * j + 2] == 0) {
+          block = stored;  // the common case: nothing held in the row or the column
+        } else {
+          const Vec3 column_free(fixed[3 * j] ? 0.0 : 1.0, fixed[3 * j + 1] ? 0.0 : 1.0, fixed[3 * j + 2] ? 0.0 : 1.0);
+          block = row_free.asDiagonal() * stored * column_free.asDiagonal();
+        }
         if (block.isZero(0.0)) continue;
         for (int e = p.fine_start[j]; e < p.fine_start[j + 1]; ++e) {
           const auto& entry = p.by_fine[static_cast<std::size_t>(e)];
