@@ -233,8 +233,7 @@ void Dynamics::hand_system_to_solver(double c_mass) {
   const bool taken_as_blocks = keep && origin_of_new_.empty() && solver_->update_block_values(system_blocks_, model_.volume);
   bool set_up_with_operator = false;
   if (!taken_as_blocks && settings_.matrix_free)  // step() set the operator's state
-    set_up_with_operator =
-        solver_->setup_operator(system_operator_, system_blocks_, model_.volume, solver_ready_ && origins_known() ? &origin_of_new_ : nullptr);
+    set_up_with_operator = solver_->setup_operator(system_operator_, system_blocks_, model_.volume);
   if (set_up_with_operator) {
     solver_ready_ = true;
     solver_mass_factor_ = c_mass;

@@ -126,16 +126,11 @@ class LinearSolver {
   /// referenced and must outlive the solves), given also assembled as block CSR (`blocks`, the
   /// same values, fixed dofs eliminated) for what needs its entries: the multigrid builds its
   /// coarse levels from them and keeps no copy. Any topology (no relation to the last setup).
-  /// `origin_of_new`, where known: the topology is the last setup's after cuts, vertex n + i a copy
-  /// of the old vertex origin_of_new[i] (none: the same vertices), so that estimates of the old
-  /// operator carry over to the new one (the multigrid's fine smoother bound); null: unrelated.
   /// false (the default), with nothing done: the solver needs the scalar matrix (setup()).
-  virtual bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology,
-                              const std::vector<VertexId>* origin_of_new) {
+  virtual bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology) {
     (void)a;
     (void)blocks;
     (void)topology;
-    (void)origin_of_new;
     return false;
   }
   /// update_topology() with the new matrix also given as block CSR (the same values, its block

@@ -103,25 +103,23 @@ class MultigridCgSolver final : public LinearSolver {
     return true;
   }
 
-  bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology,
-                      const std::vector<VertexId>* origin_of_new) override {
+  bool setup_operator(const VertexOperator& a, const BlockSparseMatrix<double>& blocks, const LinkedVolume& topology) override {
     // Checked before anything is dropped: a refused set-up leaves the solver as it was.
     if (blocks.rows() != a.rows())
       throw InputError(fmt::format("multigrid: the block copy of the operator has {} rows; the operator has {}", blocks.rows(), a.rows()));
-    // The old fine smoother's bound and vector: the new estimate continues them where the new
-    // fine level is the old one, or the old one after cuts whose copies' origins are known (4
-    // power iterations instead of 12: 10-14 ms of a 44k rebuild after a cut).
+    // The old fine smoother's bound and vector: the new estimate continues them when the fine
+    // level keeps its size (a rebuild for new values; 4 power iterations instead of 12).
     ChebyshevSmoother before;
-    if (preconditioner_.levels().size() > 1 && origin_of_new != nullptr) {
+    if (preconditioner_.levels().size() > 1) {
       before.lambda_max = preconditioner_.levels()[0].smoother.lambda_max;
       before.lambda_vector = preconditioner_.levels()[0].smoother.lambda_vector;
     }
-    const std::vector<VertexId> copies = origin_of_new != nullptr ? *origin_of_new : std::vector<VertexId>();
+    const std::vector<VertexId> no_copies;
     preconditioner_ = MultigridPreconditioner();  // the old levels go before the new ones are built
     a_blocks_ = BlockSparseMatrix<double>();
     pattern_row_start_.clear();
     rows_ = a.rows();
-    preconditioner_ = build_multigrid_for_operator(a, blocks, topology, options_, ChebyshevWarmStart{&before, &copies});
+    preconditioner_ = build_multigrid_for_operator(a, blocks, topology, options_, ChebyshevWarmStart{&before, &no_copies});
     if (preconditioner_.uses_fine_operator()) {
       operator_ = &a;
     } else {  // one level: its factorization preconditions, CG multiplies with the blocks
@@ -159,8 +157,7 @@ class MultigridCgSolver final : public LinearSolver {
     if (stale.converged || stale.iterations >= settings_.max_iterations) return track(stale);
     // The kept levels no longer fit the matrix: rebuild them from its current values, go on from x.
     if (operator_ != nullptr) {
-      const std::vector<VertexId> same_vertices;
-      setup_operator(*operator_, to_block_sparse<double>(operator_->assembled_matrix()), *topology_, &same_vertices);
+      setup_operator(*operator_, to_block_sparse<double>(operator_->assembled_matrix()), *topology_);
     } else {
       preconditioner_ = MultigridPreconditioner();
       build(*topology_);  // the blocks hold the current values (update_values and update_block_values keep them so)
