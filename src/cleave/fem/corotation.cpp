@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <limits>
 #include <Eigen/SVD>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -118,6 +119,8 @@ void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::
 }
 
 Mat3 rotation_by_svd(const Mat3& f) {
+  // Eigen's SVD of a non-finite matrix leaves parts of U and V unset (uninitialized memory).
+  if (!f.allFinite()) return Mat3::Constant(std::numeric_limits<double>::quiet_NaN());
   const Eigen::JacobiSVD<Mat3> svd(f, Eigen::ComputeFullU | Eigen::ComputeFullV);
   Mat3 u = svd.matrixU();
   const Mat3 v = svd.matrixV();

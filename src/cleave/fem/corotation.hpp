@@ -21,7 +21,9 @@ Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
 /// go to the SVD are taken one by one): the same rotations to rounding, about 3x faster than one at
 /// a time (the cell passes of every dynamic step run it on all cells).
 void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::span<Mat3> rotations);
-/// The same by the SVD alone (the reference the Newton iteration is tested against).
+/// The same by the SVD alone (the reference the Newton iteration is tested against). A gradient
+/// with a non-finite entry has no rotation: all NaN, from either function (the step that made it
+/// then reports its non-finite displacement).
 Mat3 rotation_by_svd(const Mat3& deformation_gradient);
 
 /// The strain of F = R S in the frame turned by R: sym(R^T F) - I, as Voigt with engineering
