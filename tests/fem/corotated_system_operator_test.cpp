@@ -234,10 +234,10 @@ TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
     Vector wide_exact;
     op.multiply(Vector(x.cast<double>()), wide_exact);
     const double scale = exact.lpNorm<Eigen::Infinity>();
+    ASSERT_GT(scale, 1.0);
     // The double passes: the same operations in another order (and the held rows copied alike).
     EXPECT_LE((wide_exact - exact).lpNorm<Eigen::Infinity>(), 1e-13 * scale);
     EXPECT_LE((wide_exact - op.assembled_matrix() * Vector(x.cast<double>())).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
-    ASSERT_GT(scale, 1.0);
     // Float rounding in another order of the same operations: far below the 3e-6 both meet.
     EXPECT_LE((wide - portable).cast<double>().lpNorm<Eigen::Infinity>(), 1e-6 * scale);
     EXPECT_LE((wide.cast<double>() - exact).lpNorm<Eigen::Infinity>(), 3e-6 * scale);

@@ -1,8 +1,9 @@
 #pragma once
-// The float cell pass of the corotated system's product (fem/corotated_system_operator.hpp) in
-// AVX-512, two cells per 16-lane register: lanes 0-7 the first cell's 8 corners, lanes 8-15 the
-// second's; the double pass one cell per 8-lane register. The portable pass (AVX2 through Eigen, one cell per 8-lane register) does the same
-// arithmetic; on a core with two 512-bit FMA pipes this one does it in half the instructions.
+// The cell passes of the corotated system's product (fem/corotated_system_operator.hpp) in
+// AVX-512. Float: two cells per 16-lane register, lanes 0-7 the first cell's 8 corners, lanes 8-15
+// the second's; double: one cell per 8-lane register. The portable pass (AVX2 through Eigen, one
+// cell per 8-float register) does the same arithmetic; on a core with two 512-bit FMA pipes this
+// one does it in half the instructions.
 //
 // Only this file's .cpp is compiled for AVX-512, and it includes no Eigen and no inline code it
 // could share with the rest of the library (an AVX-512 copy of a shared inline function could be

@@ -1,15 +1,16 @@
 #include "cleave/fem/corotation.hpp"
 
 #include <Eigen/Geometry>
-#include <fmt/format.h>
 #include <Eigen/LU>
+#include <Eigen/SVD>
+#include <fmt/format.h>
+#include <tbb/blocked_range.h>
+#include <tbb/parallel_for.h>
+
 #include <algorithm>
 #include <array>
 #include <cmath>
 #include <limits>
-#include <Eigen/SVD>
-#include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/fem/hex8_element.hpp"
@@ -53,7 +54,7 @@ using Lanes = Eigen::Array<double, kLanes, 1>;
 
 /// `count` (1 to kLanes) gradients' Newton iteration in lanes: entry (i, j) of every lane's X in
 /// x[3 i + j]. A lane whose determinant is not positive and finite, or that has not settled after
-/// kNewtonMaxIterations, is left to rotation_from_deformation_gradient alone.
+/// kNewtonMaxIterations, goes to the SVD, as in rotation_from_deformation_gradient.
 void rotations_in_lanes(const Mat3* f, Mat3* rotations, int count) {
   std::array<Lanes, 9> x;
   for (int lane = 0; lane < kLanes; ++lane) {
