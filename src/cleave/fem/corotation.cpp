@@ -145,15 +145,8 @@ Vec6 corotated_strain(const Mat3& f, const Mat3& r) {
 
 void cell_rotations(const LinkedVolume& volume, const Vector& u, std::vector<Mat3>& rotations) {
   rotations.resize(static_cast<std::size_t>(volume.cell_count()));
-  const double h = volume.grid().cell_size_mm;
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
-    std::array<Mat3, kLanes> gradients;
-    for (CellId c = r.begin(); c < r.end(); c += kLanes) {
-      const int count = std::min(kLanes, r.end() - c);
-      for (int i = 0; i < count; ++i)
-        gradients[static_cast<std::size_t>(i)] = hex8_center_deformation_gradient(cell_displacement(volume, c + i, u), h);
-      rotations_in_lanes(gradients.data(), rotations.data() + c, count);
-    }
+    cell_frames_in_range(volume, u, r.begin(), r.end(), rotations, [](CellId, const Mat3&) {});
   });
 }
 

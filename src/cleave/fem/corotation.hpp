@@ -1,6 +1,8 @@
 #pragma once
 // Corotational frames of the cells: the rotation R of each cell from the deformation gradient F
 // at its centre, by polar decomposition F = R S (R proper orthogonal, S symmetric).
+#include <algorithm>
+#include <array>
 #include <span>
 #include <vector>
 
@@ -40,5 +42,24 @@ Vec24 cell_displacement(const LinkedVolume& volume, CellId c, const Vector& disp
 /// positions x = X + u brought back into the cell's reference frame, relative to node 0 (K^e and
 /// T^e do not see translations).
 Vec24 corotated_displacement(const Vec24& cell_displacement_mm, const Mat3& rotation, double h_mm);
+
+/// For the cells [begin, end) (one parallel task's range): F at each cell's centre and its
+/// rotation into rotations[c], four cells at a time (rotations_from_deformation_gradients), then
+/// each(c, F) per cell. `rotations` holds one per cell of the volume.
+template <typename Each>
+void cell_frames_in_range(const LinkedVolume& volume, const Vector& displacement_mm, CellId begin, CellId end,
+                          std::vector<Mat3>& rotations, Each&& each) {
+  constexpr CellId kBatch = 4;  // the lanes of rotations_from_deformation_gradients
+  const double h = volume.grid().cell_size_mm;
+  std::array<Mat3, kBatch> gradients;
+  for (CellId first = begin; first < end; first += kBatch) {
+    const auto count = static_cast<std::size_t>(std::min(kBatch, end - first));
+    for (std::size_t i = 0; i < count; ++i)
+      gradients[i] = hex8_center_deformation_gradient(cell_displacement(volume, first + static_cast<CellId>(i), displacement_mm), h);
+    rotations_from_deformation_gradients(std::span<const Mat3>(gradients.data(), count),
+                                         std::span<Mat3>(rotations).subspan(static_cast<std::size_t>(first), count));
+    for (std::size_t i = 0; i < count; ++i) each(first + static_cast<CellId>(i), gradients[i]);
+  }
+}
 
 }  // namespace cleave

@@ -1,9 +1,6 @@
 #include "cleave/fem/stress_stiffness.hpp"
 
 #include <Eigen/Eigenvalues>
-#include <algorithm>
-#include <array>
-#include <span>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
@@ -36,24 +33,13 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
   const auto cells = static_cast<std::size_t>(volume.cell_count());
   rotations.resize(cells);
   tension_kPa.resize(cells);
-  const double h = table.cell_size_mm;
-  constexpr CellId kBatch = 4;  // rotations_from_deformation_gradients' lanes
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
-    std::array<Mat3, kBatch> gradients;
-    for (CellId first = r.begin(); first < r.end(); first += kBatch) {
-      const auto count = static_cast<std::size_t>(std::min(kBatch, r.end() - first));
-      for (std::size_t i = 0; i < count; ++i)
-        gradients[i] = hex8_center_deformation_gradient(cell_displacement(volume, first + static_cast<CellId>(i), displacement_mm), h);
-      const auto begin = static_cast<std::size_t>(first);
-      rotations_from_deformation_gradients(std::span<const Mat3>(gradients.data(), count), std::span<Mat3>(rotations).subspan(begin, count));
-      for (std::size_t i = 0; i < count; ++i) {
-        const std::size_t ci = begin + i;
-        const CellId c = first + static_cast<CellId>(i);
-        Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(gradients[i], rotations[ci]);
-        if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
-        tension_kPa[ci] = tensile_part(stress);
-      }
-    }
+    cell_frames_in_range(volume, displacement_mm, r.begin(), r.end(), rotations, [&](CellId c, const Mat3& f) {
+      const auto ci = static_cast<std::size_t>(c);
+      Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, rotations[ci]);
+      if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
+      tension_kPa[ci] = tensile_part(stress);
+    });
   });
 }
 
