@@ -49,7 +49,7 @@ Mat3 rotation_from_deformation_gradient(const Mat3& f) {
 
 namespace {
 
-constexpr int kLanes = 4;  ///< one AVX2 register of doubles
+constexpr int kLanes = kPolarLanes;
 using Lanes = Eigen::Array<double, kLanes, 1>;
 
 /// `count` (1 to kLanes) gradients' Newton iteration in lanes: entry (i, j) of every lane's X in

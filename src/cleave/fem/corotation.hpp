@@ -23,6 +23,8 @@ Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
 /// go to the SVD are taken one by one): the same rotations to rounding, about 3x faster than one at
 /// a time (the cell passes of every dynamic step run it on all cells).
 void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::span<Mat3> rotations);
+/// How many gradients rotations_from_deformation_gradients takes at once (one AVX2 register of doubles).
+inline constexpr int kPolarLanes = 4;
 /// The same by the SVD alone (the reference the Newton iteration is tested against). A gradient
 /// with a non-finite entry has no rotation: all NaN, from either function (the step that made it
 /// then reports its non-finite displacement).
@@ -49,7 +51,7 @@ Vec24 corotated_displacement(const Vec24& cell_displacement_mm, const Mat3& rota
 template <typename Each>
 void cell_frames_in_range(const LinkedVolume& volume, const Vector& displacement_mm, CellId begin, CellId end,
                           std::vector<Mat3>& rotations, Each&& each) {
-  constexpr CellId kBatch = 4;  // the lanes of rotations_from_deformation_gradients
+  constexpr CellId kBatch = kPolarLanes;
   const double h = volume.grid().cell_size_mm;
   std::array<Mat3, kBatch> gradients;
   for (CellId first = begin; first < end; first += kBatch) {
