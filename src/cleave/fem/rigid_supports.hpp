@@ -32,8 +32,8 @@ RigidSupportReport add_rigid_supports(const LinkedVolume& volume, FixedDofs& fix
 ///   remover.remove(u);
 class RigidMotionRemover {
  public:
-  /// The volume must keep its topology and positions while the remover is used. InputError for
-  /// weights that are not one per dof or components that do not exist.
+  /// The volume's topology and positions are read here only: the remover serves displacements of
+  /// that topology. InputError for weights that are not one per dof or components that do not exist.
   RigidMotionRemover(const LinkedVolume& volume, std::span<const int> components, Vector weights);
   ~RigidMotionRemover();
   RigidMotionRemover(RigidMotionRemover&&) noexcept;
@@ -44,9 +44,9 @@ class RigidMotionRemover {
 
  private:
   struct Piece;
-  const LinkedVolume* volume_;
   std::vector<int> piece_of_vertex_;  ///< index into pieces_; -1 where the vertex's piece is left alone
   std::vector<Piece> pieces_;
+  std::vector<Vec3> offset_;  ///< per vertex of a listed piece: (position - piece centre) / piece radius
   Vector weights_;
 };
 
