@@ -14,6 +14,7 @@
 #include "cleave/fem/residual_stress_forces.hpp"
 #include "cleave/fem/rigid_supports.hpp"
 #include "cleave/stress/equilibrate_stress.hpp"
+#include "cleave/stress/equilibrium_operator.hpp"
 #include "cleave/stress/sparse_cholesky.hpp"
 #include "cleave/stress/stress_designer.hpp"
 #include "stress_test_models.hpp"
@@ -75,6 +76,12 @@ TEST(Equilibration, DesignedStressBecomesSelfBalancedAndTheBodyStaysAtRest) {
   EXPECT_LT(forces.cwiseAbs().maxCoeff(), 1e-9 * designed_forces.cwiseAbs().maxCoeff());
   EXPECT_LT(result.residual_final, 1e-10);
   EXPECT_GT(result.residual_designed, 1e-4);
+  // The designer takes both residuals from the equilibration's own forces: they equal the ones
+  // measured with the matrix T (rounding aside, which is all of T sigma).
+  const SparseMatrix t = stress_divergence_matrix(m.volume);
+  const EquilibriumNorm norm = equilibrium_norm(t);
+  EXPECT_NEAR(result.residual_designed, relative_equilibrium_residual(t, norm, result.designed_kPa), 1e-9 * result.residual_designed);
+  EXPECT_NEAR(result.residual_final, relative_equilibrium_residual(t, norm, result.stress_kPa), 1e-13);
 
   // The free, uncut body does not move under its residual stress; under the raw design it does.
   const double size = m.size_mm();

@@ -237,6 +237,7 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
   Vector load = residual_stress_forces(volume, designed_kPa);
   impl_->mask(load);
   const double load_norm = load.norm();
+  result.designed_force_mN = load_norm;
   if (load_norm == 0.0) return result;
   if (!std::isfinite(load_norm))
     throw ComputeError(fmt::format("stress equilibration: the forces T sigma_d of the designed stress are not finite "
@@ -256,7 +257,8 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
   }
   Vector remaining = residual_stress_forces(volume, result.stress_kPa);
   impl_->mask(remaining);
-  result.force_reduction = remaining.norm() / load_norm;
+  result.remaining_force_mN = remaining.norm();
+  result.force_reduction = result.remaining_force_mN / load_norm;
   if (!(result.force_reduction <= kRequiredReduction)) {
     impl_->u.setZero();  // do not warm-start the next call from a failed solve
     throw ComputeError(fmt::format("stress equilibration reached only ||T sigma|| / ||T sigma_d|| = {:.3g} after {} "

@@ -45,6 +45,8 @@ namespace cleave {
 struct EquilibrationResult {
   std::vector<Vec6> stress_kPa;         ///< self-balanced field, one per cell
   double force_reduction = 0;           ///< ||T sigma|| / ||T sigma_d|| over free vertices (0 when sigma_d was balanced)
+  double designed_force_mN = 0;         ///< ||T sigma_d|| over free vertices (kPa mm^2)
+  double remaining_force_mN = 0;        ///< ||T sigma|| over free vertices: what the solve left
   int refinement_steps = 0;             ///< solves with the factor (preconditioned CG iterations); 0 when remembered
 };
 

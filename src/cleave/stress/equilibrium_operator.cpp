@@ -101,6 +101,13 @@ std::vector<Vec6> unflatten_stress(const Vector& flat) {
   return stress;
 }
 
+double relative_equilibrium_residual(double force_norm_mN, const EquilibriumNorm& norm, std::span<const Vec6> stress_kPa) {
+  double squared = 0.0;
+  for (const Vec6& s : stress_kPa) squared += s.squaredNorm();
+  const double denominator = norm.spectral_norm_mm2 * std::sqrt(squared);
+  return denominator == 0.0 ? 0.0 : force_norm_mN / denominator;
+}
+
 double relative_equilibrium_residual(const SparseMatrix& t, const EquilibriumNorm& norm, std::span<const Vec6> stress_kPa) {
   if (static_cast<Eigen::Index>(6 * stress_kPa.size()) != t.cols())
     throw InputError(fmt::format("stress holds {} cell tensors; expected {}", stress_kPa.size(), t.cols() / 6));

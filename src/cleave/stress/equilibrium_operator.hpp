@@ -44,6 +44,8 @@ EquilibriumNorm equilibrium_norm(const SparseMatrix& t);
 
 /// ||T sigma||_2 / (||T||_2 ||sigma||_2); 0 for a zero field. Stress in kPa (the ratio has no unit).
 double relative_equilibrium_residual(const SparseMatrix& t, const EquilibriumNorm& norm, std::span<const Vec6> stress_kPa);
+/// The same from ||T sigma|| already known (the equilibration's forces at free vertices, mN = kPa mm^2).
+double relative_equilibrium_residual(double force_norm_mN, const EquilibriumNorm& norm, std::span<const Vec6> stress_kPa);
 
 /// Flattens per-cell Voigt tensors into one vector of 6 n_c values and back.
 Vector flatten_stress(std::span<const Vec6> stress_kPa);

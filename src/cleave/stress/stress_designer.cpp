@@ -118,19 +118,24 @@ void StressDesigner::update_eigenvalues(const StressDesign& design, DesignResult
 
 void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
   out.designed_kPa = stress_from_frames(out.frames, out.eigenvalues_kPa);
-  out.residual_designed = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.designed_kPa);
   const auto start = std::chrono::steady_clock::now();
   if (design.equilibration == Equilibration::growth) {
     if (!ops_->equilibrator) ops_->equilibrator = std::make_unique<StressEquilibrator>(model_, ops_->held_vertices);
     EquilibrationResult balanced = ops_->equilibrator->equilibrate(out.designed_kPa);
     out.stress_kPa = std::move(balanced.stress_kPa);
     out.equilibration_iterations = balanced.refinement_steps;
-  } else {
-    out.stress_kPa = out.designed_kPa;
-    out.equilibration_iterations = 0;
+    out.timings.equilibration_s = seconds_since(start);
+    // The equilibration measured T sigma_d and T sigma at the free vertices (the rows the
+    // designer's T keeps): no product with T for the two residuals.
+    out.residual_designed = relative_equilibrium_residual(balanced.designed_force_mN, ops_->norm, out.designed_kPa);
+    out.residual_final = relative_equilibrium_residual(balanced.remaining_force_mN, ops_->norm, out.stress_kPa);
+    return;
   }
-  out.timings.equilibration_s = seconds_since(start);
-  out.residual_final = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.stress_kPa);
+  out.stress_kPa = out.designed_kPa;
+  out.equilibration_iterations = 0;
+  out.timings.equilibration_s = 0;
+  out.residual_designed = relative_equilibrium_residual(ops_->divergence, ops_->norm, out.designed_kPa);
+  out.residual_final = out.residual_designed;
 }
 
 void StressDesigner::set_design(StressDesign design) {
