@@ -11,7 +11,10 @@
 #include <algorithm>
 #include <cmath>
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/LU>
+#include <cstdlib>
+#include <vector>
 
 #include "cleave/stress/direction_frames.hpp"
 #include "cleave/stress/line_field_interpolation.hpp"
@@ -110,6 +113,47 @@ TEST(DirectionField, FramesFromKeptNormalAxesEqualFramesFromTheNormalTensors) {
   }
   EXPECT_EQ(message, fmt::format("direction frames got {} Langer tensors and 3 normal axes; expected one of each per cell",
                                  langer_tensors.size()));
+}
+
+TEST(DirectionField, TheLangerAxisIsThePrincipalAxisOfTheTensorProjectedNormalToTheNormal) {
+  // The frames solve a 2x2 problem in the plane normal to n; the reference here is the 3x3
+  // eigen-solve (iterative) of P L P, P = I - n n^T, on random tensors and normals, the axis
+  // compared up to its sign. Where the projected tensor has no preferred axis (equal in-plane
+  // eigenvalues, or none above 1e-12) the axis is any unit vector normal to n.
+  std::srand(7);
+  std::vector<Mat3> langer_tensors;
+  std::vector<Vec3> normals;
+  for (int i = 0; i < 2000; ++i) {
+    const Mat3 a = Mat3::Random();
+    langer_tensors.push_back(a * a.transpose());  // positive semidefinite, as interpolated line tensors
+    normals.push_back(Vec3::Random().normalized());
+  }
+  const Vec3 n0 = Vec3::UnitZ();
+  langer_tensors.push_back(Mat3::Identity());  // isotropic in the plane
+  normals.push_back(n0);
+  langer_tensors.push_back(Mat3::Zero());  // no direction
+  normals.push_back(n0);
+  langer_tensors.push_back(Vec3::UnitX() * Vec3::UnitX().transpose());  // along a basis axis of the plane
+  normals.push_back(n0);
+  langer_tensors.push_back(Vec3::UnitY() * Vec3::UnitY().transpose());
+  normals.push_back(n0);
+  const std::vector<DirectionFrame> frames = direction_frames(langer_tensors, normals);
+  int compared = 0;
+  for (std::size_t c = 0; c < frames.size(); ++c) {
+    const DirectionFrame& f = frames[c];
+    EXPECT_NEAR(f.langer.norm(), 1.0, 1e-12) << "cell " << c;
+    EXPECT_NEAR(f.langer.dot(normals[c]), 0.0, 1e-12) << "cell " << c;
+    EXPECT_NEAR((f.normal.cross(f.langer) - f.cross).norm(), 0.0, 1e-12) << "cell " << c;
+    const Mat3 p = Mat3::Identity() - normals[c] * normals[c].transpose();
+    Eigen::SelfAdjointEigenSolver<Mat3> reference(p * langer_tensors[c] * p);
+    const Vec3 values = reference.eigenvalues();
+    if (values[2] - values[1] < 1e-6 * std::max(values[2], 1.0)) continue;  // no preferred axis
+    EXPECT_NEAR(std::abs(f.langer.dot(reference.eigenvectors().col(2))), 1.0, 1e-10) << "cell " << c;
+    ++compared;
+  }
+  EXPECT_GE(compared, 2000);
+  EXPECT_NEAR(std::abs(frames[2002].langer.x()), 1.0, 1e-15);
+  EXPECT_NEAR(std::abs(frames[2003].langer.y()), 1.0, 1e-15);
 }
 
 TEST(DirectionField, ReversingAnySubsetOfStrokesGivesTheSameField) {

@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <cmath>
 #include <fmt/format.h>
+#include <limits>
 #include <numbers>
 
 #include <tbb/parallel_for.h>
@@ -31,7 +32,26 @@ Vec3 normal_axis(const Mat3& normal_tensor) {
   return normal_eig.eigenvalues()[2] > kNoDirection ? Vec3(normal_eig.eigenvectors().col(2)) : Vec3::Zero();
 }
 
+/// The principal axis of the symmetric 2x2 matrix [a b; b c] in the basis (e1, e2), as a unit
+/// vector; zero when its larger eigenvalue is at most kNoDirection or the two eigenvalues are
+/// equal (no preferred axis). Of the two forms of the eigenvector, (b, l - a) and (l - c, b), the
+/// longer one: the other vanishes where the axis is (near) e1 or e2. NaN for a non-finite matrix,
+/// so that the frame is refused (check_frames_finite) rather than given an arbitrary axis.
+Vec3 principal_axis_in_plane(double a, double b, double c, const Vec3& e1, const Vec3& e2) {
+  if (!std::isfinite(a) || !std::isfinite(b) || !std::isfinite(c)) return Vec3::Constant(std::numeric_limits<double>::quiet_NaN());
+  const double half_gap = 0.5 * (a - c);
+  const double radius = std::hypot(half_gap, b);
+  const double largest = 0.5 * (a + c) + radius;
+  if (!(largest > kNoDirection) || !(radius > 0.0)) return Vec3::Zero();
+  const double along_e1 = half_gap >= 0.0 ? half_gap + radius : b;  // l - c or b
+  const double along_e2 = half_gap >= 0.0 ? b : radius - half_gap;  // b or l - a
+  return (along_e1 * e1 + along_e2 * e2).normalized();
+}
+
 /// The frame about the normal axis `axis` (zero: none; the Langer tensor's weakest axis then).
+/// The Langer direction is the principal axis of the Langer tensor projected onto the plane
+/// normal to n, found as a 2x2 problem in that plane (the 3x3 eigen-solve of P L P it replaces
+/// gave the same axis, at twice the time per cell).
 DirectionFrame frame_about(const Mat3& langer_tensor, const Vec3& axis) {
   DirectionFrame frame;
   Vec3 n = Vec3::UnitZ();
@@ -43,14 +63,12 @@ DirectionFrame frame_about(const Mat3& langer_tensor, const Vec3& axis) {
     if (langer_eig.eigenvalues()[2] > kNoDirection) n = langer_eig.eigenvectors().col(0);
   }
   n.normalize();
-  const Mat3 p = Mat3::Identity() - n * n.transpose();
-  const Mat3 projected = p * langer_tensor * p;
-  Eigen::SelfAdjointEigenSolver<Mat3> eig;
-  eig.computeDirect(0.5 * (projected + projected.transpose()));
-  Vec3 t = eig.eigenvectors().col(2);
-  t -= t.dot(n) * n;  // remove round-off along n
-  if (eig.eigenvalues()[2] <= kNoDirection || t.norm() < 0.5) t = any_orthogonal(n);
-  t.normalize();
+  const Vec3 e1 = any_orthogonal(n);
+  const Vec3 e2 = n.cross(e1);
+  const Mat3 symmetric = 0.5 * (langer_tensor + langer_tensor.transpose());
+  const Vec3 l_e1 = symmetric * e1;
+  Vec3 t = principal_axis_in_plane(e1.dot(l_e1), e2.dot(l_e1), e2.dot(symmetric * e2), e1, e2);
+  if (t == Vec3::Zero()) t = e1;
   frame.normal = n;
   frame.langer = t;
   frame.cross = n.cross(t).normalized();
