@@ -111,12 +111,9 @@ double relative_equilibrium_residual(double force_norm_mN, const EquilibriumNorm
 double relative_equilibrium_residual(const SparseMatrix& t, const EquilibriumNorm& norm, std::span<const Vec6> stress_kPa) {
   if (static_cast<Eigen::Index>(6 * stress_kPa.size()) != t.cols())
     throw InputError(fmt::format("stress holds {} cell tensors; expected {}", stress_kPa.size(), t.cols() / 6));
-  const Vector s = flatten_stress(stress_kPa);
-  const double denominator = norm.spectral_norm_mm2 * s.norm();
-  if (denominator == 0.0) return 0.0;
   Vector ts;
-  multiply(t, s, ts);  // on all cores (Eigen's sparse product runs on one)
-  return ts.norm() / denominator;
+  multiply(t, flatten_stress(stress_kPa), ts);  // on all cores (Eigen's sparse product runs on one)
+  return relative_equilibrium_residual(ts.norm(), norm, stress_kPa);
 }
 
 }  // namespace cleave
