@@ -254,9 +254,9 @@ TEST(DirectionField, BadStrokesAreRefusedWithTheirIndex) {
   };
   EXPECT_EQ(message(DesignStroke{{}, StrokePlacement::surface}), "design stroke 0 has 0 points; expected at least two points");
   EXPECT_EQ(message(DesignStroke{{{1, 2, 10}}, StrokePlacement::surface}), "design stroke 0 has 1 point; expected at least two points");
-  EXPECT_EQ(message(DesignStroke{{{1, 2, 10}, {NAN, 2, 10}}, StrokePlacement::surface}),
+  EXPECT_EQ(message(DesignStroke{{{1, 2, 10}, {std::numeric_limits<double>::quiet_NaN(), 2, 10}}, StrokePlacement::surface}),
             "design stroke 0 point 1 is not finite; expected coordinates in mm");
-  EXPECT_EQ(message(DesignStroke{{{1, 2, 10}, {INFINITY, 2, 10}}, StrokePlacement::surface}),
+  EXPECT_EQ(message(DesignStroke{{{1, 2, 10}, {std::numeric_limits<double>::infinity(), 2, 10}}, StrokePlacement::surface}),
             "design stroke 0 point 1 is not finite; expected coordinates in mm");
   EXPECT_EQ(message(DesignStroke{{{50, 50, 10}, {60, 50, 30}}, StrokePlacement::surface}),
             "design stroke 0 point 1 at (60, 50, 30) mm is 20.1 mm from the body surface; expected within 5 mm");
