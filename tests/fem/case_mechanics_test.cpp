@@ -119,9 +119,15 @@ TEST(CaseMechanics, DirectResidualStressIsReadPerCell) {
 
 TEST(CaseMechanics, BadResidualStressIsNamed) {
   EXPECT_EQ(stress_error(R"({"uniform_kPa": [20, 10, "NaN", 0, 0, 0]})"),
-            "case.json: /residual_stress/uniform_kPa/2 is \"NaN\"; expected a finite stress in kPa");
+            "case.json: /residual_stress/uniform_kPa/2 is \"NaN\"; expected a finite stress in kPa, at most 1e9 in magnitude");
   EXPECT_EQ(stress_error(R"({"uniform_kPa": [null, 10, 0, 0, 0, 0]})"),
-            "case.json: /residual_stress/uniform_kPa/0 is null; expected a finite stress in kPa");
+            "case.json: /residual_stress/uniform_kPa/0 is null; expected a finite stress in kPa, at most 1e9 in magnitude");
+  // Finite but beyond any material: the forces (stress x area) would overflow.
+  EXPECT_EQ(stress_error(R"({"uniform_kPa": [20, 10, 0, -1e200, 0, 0]})"),
+            "case.json: /residual_stress/uniform_kPa/3 is -1e+200; expected a finite stress in kPa, at most 1e9 in magnitude");
+  EXPECT_EQ(stress_error(R"({"per_label_kPa": {"1": [2e9, 0, 0, 0, 0, 0]}})"),
+            "case.json: /residual_stress/per_label_kPa/1/0 is 2000000000.0; expected a finite stress in kPa, at most 1e9 in magnitude");
+  EXPECT_EQ(stress_error(R"({"uniform_kPa": [1e9, -1e9, 0, 0, 0, 0]})"), "no error");
   EXPECT_EQ(stress_error(R"({"uniform_kPa": [1e999, 10, 0, 0, 0, 0]})"), "case.json: invalid JSON: number overflow parsing '1e999'");
   EXPECT_EQ(stress_error(R"({"uniform_kPa": [20, 10, 0]})"),
             "case.json: /residual_stress/uniform_kPa is [20,10,0]; expected [xx, yy, zz, xy, xz, yz] (six finite stresses in kPa)");

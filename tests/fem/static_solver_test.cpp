@@ -4,7 +4,9 @@
 
 #include <thread>
 
+#include "cleave/core/error.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
+#include "cleave/fem/solve_static.hpp"
 #include "cleave/fem/static_solver.hpp"
 #include "cleave/grid/linked_volume.hpp"
 #include "fem_test_models.hpp"
@@ -127,6 +129,29 @@ TEST(StaticSolver, NoLoadNeedsNoSolveAndMovesNothing) {
   EXPECT_EQ(r.report.iterations, 0);
   EXPECT_EQ(statics.solves(), 0);
   EXPECT_FALSE(statics.set_up());
+}
+
+// A stress whose forces overflow (the library's API takes any finite value; the case file stops at
+// 1e9 kPa) is named, not solved into "did not converge: relative residual nan" or a zero field.
+TEST(StaticSolver, ALoadThatOverflowsIsNamed) {
+  const TissueModel model = test::make_box_model({3, 3, 3}, 2.0);
+  StaticOptions options;
+  options.solver = SolverKind::multigrid_cg;
+  StaticSolver statics(model, options);
+  std::vector<Vec6> stress = graded_stress(model.volume, 1.0);
+  stress[5][0] = 1e308;
+  try {
+    (void)statics.solve(stress);
+    FAIL() << "expected a ComputeError";
+  } catch (const ComputeError& e) {
+    EXPECT_STREQ(e.what(), "static solve: the load overflows double precision (largest residual stress 1e+308 kPa); expected finite "
+                           "stresses of at most 1e+09 kPa and finite external forces");
+  }
+  EXPECT_EQ(statics.solves(), 0);
+  // The solver stays usable: a sane stress afterwards is solved as by a fresh solver.
+  const StaticResult sane = statics.solve(graded_stress(model.volume, 1.0));
+  EXPECT_GT(max_norm_mm(sane.displacement_mm), 0.0);
+  EXPECT_EQ(max_difference_mm(sane.displacement_mm, solve_static(model, graded_stress(model.volume, 1.0), options).displacement_mm), 0.0);
 }
 
 }  // namespace

@@ -113,7 +113,9 @@ TEST(CaseDesign, BadInputNamesThePath) {
             "case.json: /design/control_points is missing; expected at least one control point {\"position\": [x, y, z], "
             "\"langer_kPa\": .., \"cross_kPa\": ..}; without one the stress would silently be zero");
   EXPECT_EQ(parse_error(R"({"control_points": [{"position": [5,5,10], "langer_kPa": "x", "cross_kPa": 10}]})"),
-            "case.json: /design/control_points/0/langer_kPa is \"x\"; expected a finite stress in kPa");
+            "case.json: /design/control_points/0/langer_kPa is \"x\"; expected a finite stress in kPa, at most 1e9 in magnitude");
+  EXPECT_EQ(parse_error(R"({"control_points": [{"position": [5,5,10], "langer_kPa": 20, "cross_kPa": 1e300}]})"),
+            "case.json: /design/control_points/0/cross_kPa is 1e+300; expected a finite stress in kPa, at most 1e9 in magnitude");
   EXPECT_EQ(parse_error(R"({"solver": "fast", )" + cp + "}"),
             "case.json: /design/solver is \"fast\"; expected \"default\" or \"paper-cg\"");
   EXPECT_EQ(parse_error(R"({"weights": {"constraint": 0}, )" + cp + "}"),

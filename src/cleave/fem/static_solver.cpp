@@ -2,9 +2,11 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <utility>
 
 #include "cleave/core/error.hpp"
+#include "cleave/core/units.hpp"
 #include "cleave/fem/assemble_stiffness.hpp"
 #include "cleave/fem/lumped_mass.hpp"
 #include "cleave/fem/residual_stress_forces.hpp"
@@ -55,6 +57,13 @@ StaticResult StaticSolver::solve_once(std::span<const Vec6> residual_stress_kPa)
   Vector f = Vector::Zero(dofs);
   if (!residual_stress_kPa.empty()) f -= residual_stress_forces(volume, residual_stress_kPa);
   if (options_.external_force_mN.size() != 0) f += options_.external_force_mN;
+  if (!std::isfinite(f.squaredNorm())) {  // also finite entries whose squares overflow (CG's dot products)
+    double largest_kPa = 0;
+    for (const Vec6& s : residual_stress_kPa) largest_kPa = std::max(largest_kPa, s.cwiseAbs().maxCoeff());
+    throw ComputeError(fmt::format("static solve: the load overflows double precision (largest residual stress {:.3g} kPa); expected "
+                                   "finite stresses of at most {:.0e} kPa and finite external forces",
+                                   largest_kPa, units::kLargestStress_kPa));
+  }
 
   StaticResult result;
   result.displacement_mm.assign(static_cast<std::size_t>(volume.vertex_count()), Vec3::Zero());
