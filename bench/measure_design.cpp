@@ -84,11 +84,9 @@ DesignOutcome measure_cleave(const TissueModel& uncut, const BenchScenario& scen
   std::vector<Vec3> picture_mm;  // deformed render surface vertices: what the page draws
   // The preview's statics are kept across edits as the studio keeps them: CHOLMOD's factor of the
   // incised body (removed plugs held), made at the first edit's solve, then one forward/back
-  // substitution per edit.
-  StaticOptions kept;
-  kept.solver = SolverKind::cholmod;
-  kept.fixed_vertices = preview.held;
-  StaticSolver statics(preview.model, preview.stiffness, kept);
+  // substitution per edit with its single-precision copy, to the picture's tolerance
+  // (preview_static_options).
+  StaticSolver statics(preview.model, preview.stiffness, preview_static_options(preview.held));
   const auto stroke_edit = [&](const DesignStroke& stroke) {
     return wall_time_ms([&] {
       designer.move_stroke(0, stroke);

@@ -285,9 +285,7 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
 }
 
 StaticResult StudioCompute::solve_preview_statics(nlohmann::json& message) {
-  StaticOptions options;
-  options.solver = SolverKind::cholmod;
-  options.fixed_vertices = held_cut_;
+  const StaticOptions options = preview_static_options(held_cut_);
   if (!preview_statics_ && pending_statics_.valid() &&
       pending_statics_.wait_for(std::chrono::seconds(0)) == std::future_status::ready) {
     try {
@@ -304,6 +302,9 @@ StaticResult StudioCompute::solve_preview_statics(nlohmann::json& message) {
     if (!preview_multigrid_) {
       StaticOptions multigrid = options;
       multigrid.solver = SolverKind::multigrid_cg;
+      // To SolveSettings' 1e-8: the picture's 1e-4 is measured for the factor's float copy, whose
+      // error is rounding; a CG stopped at 1e-4 leaves its smooth modes unbounded.
+      multigrid.settings = SolveSettings{};
       preview_multigrid_ = std::make_unique<StaticSolver>(*preview_model_, multigrid);
     }
     statics = preview_multigrid_.get();

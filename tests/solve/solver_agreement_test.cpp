@@ -144,6 +144,48 @@ TEST(SolverAgreement, CholmodNamesTheDofOfASingularMatrix) {
   }
 }
 
+// CHOLMOD with the single-precision copy of its factor (the studio's preview): one substitution
+// where it meets the tolerance, refinements with double residuals where it does not, and the
+// double factor where three do not; each result is the double solve's to its tolerance.
+TEST(SolverAgreement, CholmodWithTheSinglePrecisionFactorRefinesToTheTolerance) {
+  TissueModel model = test::make_box({12, 10, 8}, 2.5);
+  test::cut_across_middle(model, 5);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  SolveReport exact_report;
+  const Vector exact = solve_with(SolverKind::cholmod, s, model.volume, exact_report);
+  ASSERT_EQ(exact_report.iterations, 1);
+  const auto single_solve = [&](double tolerance, SolveReport& report) {
+    SolveSettings settings;
+    settings.relative_tolerance = tolerance;
+    settings.single_precision_factor = true;
+    auto solver = make_linear_solver(SolverKind::cholmod, settings);
+    solver->setup(s.a, model.volume);
+    Vector x = Vector::Zero(s.b.size());
+    report = solver->solve(s.b, x);
+    return x;
+  };
+  SolveReport picture, refined, unreachable;
+  const Vector x_picture = single_solve(1e-3, picture);
+  EXPECT_EQ(picture.iterations, 1);  // one float substitution meets it (measured 1.1e-4 on this block)
+  EXPECT_TRUE(picture.converged);
+  EXPECT_LE(picture.relative_residual, 1e-3);
+  EXPECT_GT(picture.relative_residual, 1e-12);  // the float factor's, not the double one's
+  EXPECT_LT((x_picture - exact).norm() / exact.norm(), 1e-3);
+
+  const Vector x_refined = single_solve(1e-9, refined);
+  EXPECT_EQ(refined.iterations, 2);  // one refinement (measured 1.4e-11)
+  EXPECT_TRUE(refined.converged);
+  EXPECT_LE(refined.relative_residual, 1e-9);
+  EXPECT_LT((x_refined - exact).norm() / exact.norm(), 1e-7);
+
+  // Below what float refinement reaches: three float substitutions, then the double factor, whose
+  // solution is the plain solve's bit for bit.
+  const Vector x_unreachable = single_solve(1e-30, unreachable);
+  EXPECT_EQ(unreachable.iterations, 4);
+  EXPECT_FALSE(unreachable.converged);
+  EXPECT_EQ(x_unreachable, exact);
+}
+
 TEST(SolverFactory, NamesRoundTripAndUnknownNamesAreListed) {
   for (const SolverKind kind : {SolverKind::multigrid_cg, SolverKind::eigen_cg, SolverKind::cholmod}) {
     EXPECT_EQ(solver_kind_from_name(solver_kind_name(kind)), kind);

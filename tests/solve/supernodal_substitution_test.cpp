@@ -170,6 +170,41 @@ TEST(SupernodalSubstitution, SolvesMatricesWithManyRootsAndWithOneSupernode) {
   EXPECT_DOUBLE_EQ(x(0, 1), -2.0);
 }
 
+// The single-precision copy of the factor: the same schedule (subtrees, blocked large top
+// supernodes) on float values and vectors. Its error is float rounding times the condition
+// number: small, but not the double solve's (which would mean the copy was never read).
+TEST(SupernodalSubstitution, SolvesInSinglePrecisionWithTheFactorsFloatCopy) {
+  test::LinearSystem s = block_system();
+  test::CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  const std::vector<float> values = sub.single_precision_values(chol.factor());
+  ASSERT_EQ(values.size(), chol.factor().xsize);
+  const double* exact = static_cast<const double*>(chol.factor().x);
+  for (std::size_t i = 0; i < values.size(); i += 997) EXPECT_EQ(values[i], static_cast<float>(exact[i]));
+
+  const Eigen::MatrixXd reference = chol.cholmod_solution(s.b);
+  Eigen::MatrixXf x = s.b.cast<float>();
+  sub.solve_single(chol.factor(), values, x);
+  const double error = relative_difference(x.cast<double>(), reference);
+  EXPECT_LT(error, 1e-4);   // measured 1.0e-7
+  EXPECT_GT(error, 1e-10);  // float arithmetic, not the double factor
+  // Several columns (the wide kernels) solve each column alike.
+  const Eigen::MatrixXd several = Eigen::MatrixXd::Random(s.a.rows(), 3);
+  Eigen::MatrixXf several_x = several.cast<float>();
+  sub.solve_single(chol.factor(), values, several_x);
+  EXPECT_LT(relative_difference(several_x.cast<double>(), chol.cholmod_solution(several)), 1e-4);
+
+  const std::vector<float> short_copy(values.begin(), values.end() - 1);
+  try {
+    sub.solve_single(chol.factor(), short_copy, x);
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("supernodal substitution: {} single-precision values for a factor of {}; "
+                                                 "expected a copy made by single_precision_values of this factor",
+                                                 values.size() - 1, values.size()));
+  }
+}
+
 TEST(SupernodalSubstitution, RejectsARightHandSideOfAnotherSize) {
   test::LinearSystem s = test::clamped_system(test::make_box(Vec3i{3, 2, 2}, 1.0), test::Clamp::left_end);
   test::CholmodFactor chol(s.a);

@@ -32,6 +32,18 @@ struct StaticOptions {
   Vector external_force_mN;                 ///< 3 n_v nodal forces f; empty = none
 };
 
+/// The incision preview's statics: the picture the studio draws after every design edit (and the
+/// bench's edit-to-picture update, which times it). A picture and its ellipse measurements, solved
+/// to a relative residual of 1e-4 with the single-precision copy of CHOLMOD's factor (half the
+/// bytes of a substitution with the double one). Measured in session 28 (one float substitution,
+/// against the double solve): the incised abdomen at 45k cells, residual 8.5e-6 to 9.3e-6,
+/// displacement 2.6e-5 to 2.9e-4 of its norm off (0.16 um at most, on openings of 0.6 mm); the
+/// incised 44k tube 1.2e-5 and 2e-6 to 6e-6 (11 nm of 2.7 mm): far below a pixel and a cell
+/// (1-2 mm). Batch runs (`cleave run`, the demo) keep SolveSettings' 1e-8.
+inline constexpr double kPreviewRelativeResidual = 1e-4;
+/// CHOLMOD with the single-precision factor at kPreviewRelativeResidual, `held_vertices` at rest.
+StaticOptions preview_static_options(std::vector<VertexId> held_vertices);
+
 struct StaticResult {
   std::vector<Vec3> displacement_mm;  ///< per vertex
   SolveReport report;                 ///< iterations 0 when no solve was needed (zero load)

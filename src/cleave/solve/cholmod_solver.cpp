@@ -15,6 +15,10 @@
 namespace cleave {
 namespace {
 
+/// Substitutions with the single-precision factor before the double one takes over: one refinement
+/// takes the incised 44k tube from a residual of 1.2e-5 to 2.5e-11 to 7.6e-11 (session 28).
+constexpr int kMaxSingleSubstitutions = 3;
+
 class CholmodSolver final : public LinearSolver {
  public:
   explicit CholmodSolver(const SolveSettings& settings) : settings_(settings) {
@@ -77,6 +81,8 @@ class CholmodSolver final : public LinearSolver {
     }
     if (common_.status < CHOLMOD_OK) throw ComputeError(fmt::format("cholmod: factorization failed (status {})", common_.status));
     if (settings_.parallel_substitution && !substitution_) substitution_.emplace(*factor_);
+    single_values_.clear();
+    if (substitution_ && settings_.single_precision_factor) single_values_ = substitution_->single_precision_values(*factor_);
   }
 
   SolveReport solve(const Vector& b, Vector& x) override {
@@ -91,6 +97,8 @@ class CholmodSolver final : public LinearSolver {
       report.converged = std::isfinite(b_norm);
       return report;
     }
+    Vector r;
+    if (!single_values_.empty() && solve_single_refined(b, b_norm, x, r, report)) return report;
     if (substitution_) {
       Vector solved = b;
       substitution_->solve(*factor_, solved);
@@ -98,8 +106,7 @@ class CholmodSolver final : public LinearSolver {
     } else {
       solve_with_cholmod(b, x);
     }
-    report.iterations = 1;
-    Vector r;
+    ++report.iterations;
     residual(a_, b, x, r);
     report.relative_residual = r.norm() / b_norm;
     report.converged = report.relative_residual <= settings_.relative_tolerance;
@@ -109,6 +116,31 @@ class CholmodSolver final : public LinearSolver {
   std::string_view name() const override { return "cholmod"; }
 
  private:
+  /// x = A^-1 b with the single-precision factor: a substitution, then refinements of the
+  /// residual (computed in double) until it meets the tolerance. False when it does not within
+  /// kMaxSingleSubstitutions, or a value leaves float's range: the double factor then solves
+  /// (the substitutions done are counted in report.iterations).
+  bool solve_single_refined(const Vector& b, double b_norm, Vector& x, Vector& r, SolveReport& report) {
+    Vector trial = Vector::Zero(b.size());
+    r = b;
+    for (int step = 0; step < kMaxSingleSubstitutions; ++step) {
+      Eigen::VectorXf correction = r.cast<float>();
+      if (!correction.allFinite()) return false;
+      substitution_->solve_single(*factor_, single_values_, correction);
+      ++report.iterations;
+      if (!correction.allFinite()) return false;
+      trial += correction.cast<double>();
+      residual(a_, b, trial, r);
+      report.relative_residual = r.norm() / b_norm;
+      if (report.relative_residual <= settings_.relative_tolerance) {
+        x = trial;
+        report.converged = true;
+        return true;
+      }
+    }
+    return false;
+  }
+
   /// x = A^-1 b by cholmod_solve (x unchanged when the result is not finite).
   void solve_with_cholmod(const Vector& b, Vector& x) {
     cholmod_dense rhs{};
@@ -132,6 +164,7 @@ class CholmodSolver final : public LinearSolver {
   cholmod_common common_{};
   cholmod_factor* factor_ = nullptr;
   std::optional<SupernodalSubstitution> substitution_;  ///< with parallel_substitution: the schedule of factor_
+  std::vector<float> single_values_;  ///< with single_precision_factor: factor_'s values in float
   std::vector<int> pattern_outer_, pattern_inner_;
 };
 

@@ -29,24 +29,29 @@ constexpr Eigen::Index kColumnBlock = 128;
 /// Entries of a large supernode's panel per parallel chunk of rows.
 constexpr Eigen::Index kChunkEntries = Eigen::Index{1} << 15;
 
-using ConstMatrixMap = Eigen::Map<const Eigen::MatrixXd>;
+template <typename Scalar>
+using DenseMatrix = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
 /// Right-hand sides stored by rows (narrow_panel_kernels.hpp).
 using RhsRows = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 /// One supernode of a CHOLMOD factor: columns [first, first + columns) of L, stored as a dense
 /// column-major rows x columns block whose row i is permuted row row_index[i] (the first
-/// `columns` rows are the supernode's own columns).
-struct Supernode {
+/// `columns` rows are the supernode's own columns). Scalar: the factor's double values, or a
+/// single-precision copy of them at the same offsets.
+template <typename Scalar>
+struct SupernodeOf {
   Eigen::Index first = 0;
   Eigen::Index columns = 0;
   Eigen::Index rows = 0;
   const int* row_index = nullptr;
-  const double* entries = nullptr;
+  const Scalar* entries = nullptr;
 
-  ConstMatrixMap block() const { return {entries, rows, columns}; }
+  Eigen::Map<const DenseMatrix<Scalar>> block() const { return {entries, rows, columns}; }
 };
+using Supernode = SupernodeOf<double>;
 
-Supernode supernode_of(const cholmod_factor& f, const double* values, int s) {
+template <typename Scalar>
+SupernodeOf<Scalar> supernode_of(const cholmod_factor& f, const Scalar* values, int s) {
   const auto* super = static_cast<const int*>(f.super);
   const auto* pi = static_cast<const int*>(f.pi);
   const auto* px = static_cast<const int*>(f.px);
@@ -75,44 +80,46 @@ void solve_in_place(const Triangle& t, Rows&& y) {
 
 /// L11 y1 = y1, then y(rows below) -= L21 y1: subtract_below(row, update) applies the update of
 /// one permuted row below the diagonal block. One thread.
-template <typename Subtract>
-void forward_supernode(const Supernode& sn, Eigen::MatrixXd& y, const Subtract& subtract_below) {
-  const ConstMatrixMap l = sn.block();
+template <typename Scalar, typename Subtract>
+void forward_supernode(const SupernodeOf<Scalar>& sn, DenseMatrix<Scalar>& y, const Subtract& subtract_below) {
+  const auto l = sn.block();
   auto y1 = y.middleRows(sn.first, sn.columns);
-  solve_in_place(l.topRows(sn.columns).triangularView<Eigen::Lower>(), y1);
+  solve_in_place(l.topRows(sn.columns).template triangularView<Eigen::Lower>(), y1);
   const Eigen::Index below = sn.rows - sn.columns;
   if (below == 0) return;
-  const Eigen::MatrixXd update = l.bottomRows(below) * y1;
+  const DenseMatrix<Scalar> update = l.bottomRows(below) * y1;
   for (Eigen::Index i = 0; i < below; ++i) subtract_below(sn.row_index[sn.columns + i], update.row(i));
 }
 
 /// y1 -= L21^T y(rows below), then L11^T y1 = y1. One thread.
-void backward_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
-  const ConstMatrixMap l = sn.block();
+template <typename Scalar>
+void backward_supernode(const SupernodeOf<Scalar>& sn, DenseMatrix<Scalar>& y) {
+  const auto l = sn.block();
   auto y1 = y.middleRows(sn.first, sn.columns);
   const Eigen::Index below = sn.rows - sn.columns;
   if (below > 0) {
-    Eigen::MatrixXd gathered(below, y.cols());
+    DenseMatrix<Scalar> gathered(below, y.cols());
     for (Eigen::Index i = 0; i < below; ++i) gathered.row(i) = y.row(sn.row_index[sn.columns + i]);
     y1.noalias() -= l.bottomRows(below).transpose() * gathered;
   }
-  solve_in_place(l.topRows(sn.columns).triangularView<Eigen::Lower>().transpose(), y1);
+  solve_in_place(l.topRows(sn.columns).template triangularView<Eigen::Lower>().transpose(), y1);
 }
 
 /// forward_supernode of a large supernode: column blocks, the rows below each over all threads.
-void forward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
-  const ConstMatrixMap l = sn.block();
+template <typename Scalar>
+void forward_large_supernode(const SupernodeOf<Scalar>& sn, DenseMatrix<Scalar>& y) {
+  const auto l = sn.block();
   for (Eigen::Index j0 = 0; j0 < sn.columns; j0 += kColumnBlock) {
     const Eigen::Index width = std::min(kColumnBlock, sn.columns - j0);
     auto yj = y.middleRows(sn.first + j0, width);
-    solve_in_place(l.block(j0, j0, width, width).triangularView<Eigen::Lower>(), yj);
+    solve_in_place(l.block(j0, j0, width, width).template triangularView<Eigen::Lower>(), yj);
     const Eigen::Index begin = j0 + width;
     if (begin == sn.rows) continue;
-    const Eigen::MatrixXd yj_copy = yj;  // read by every chunk while they write other rows of y
+    const DenseMatrix<Scalar> yj_copy = yj;  // read by every chunk while they write other rows of y
     tbb::parallel_for(tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)),
                       [&](const tbb::blocked_range<Eigen::Index>& range) {
                         const Eigen::Index count = range.end() - range.begin();
-                        const Eigen::MatrixXd update = l.block(range.begin(), j0, count, width) * yj_copy;
+                        const DenseMatrix<Scalar> update = l.block(range.begin(), j0, count, width) * yj_copy;
                         for (Eigen::Index i = 0; i < count; ++i) y.row(sn.row_index[range.begin() + i]) -= update.row(i);
                       });
   }
@@ -120,8 +127,10 @@ void forward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
 
 /// backward_supernode of a large supernode: column blocks from the last, each block's product
 /// with the rows below reduced over all threads.
-void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
-  const ConstMatrixMap l = sn.block();
+template <typename Scalar>
+void backward_large_supernode(const SupernodeOf<Scalar>& sn, DenseMatrix<Scalar>& y) {
+  using Dense = DenseMatrix<Scalar>;
+  const auto l = sn.block();
   const Eigen::Index blocks = (sn.columns + kColumnBlock - 1) / kColumnBlock;
   for (Eigen::Index b = blocks - 1; b >= 0; --b) {
     const Eigen::Index j0 = b * kColumnBlock;
@@ -129,27 +138,27 @@ void backward_large_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
     auto yj = y.middleRows(sn.first + j0, width);
     const Eigen::Index begin = j0 + width;
     if (begin < sn.rows) {
-      const Eigen::MatrixXd zero = Eigen::MatrixXd::Zero(width, y.cols());
+      const Dense zero = Dense::Zero(width, y.cols());
       // Deterministic: the chunks and their summation order do not depend on the scheduling.
-      const Eigen::MatrixXd product = tbb::parallel_deterministic_reduce(
+      const Dense product = tbb::parallel_deterministic_reduce(
           tbb::blocked_range<Eigen::Index>(begin, sn.rows, chunk_rows(width)), zero,
-          [&](const tbb::blocked_range<Eigen::Index>& range, Eigen::MatrixXd sum) {
+          [&](const tbb::blocked_range<Eigen::Index>& range, Dense sum) {
             const Eigen::Index count = range.end() - range.begin();
-            Eigen::MatrixXd gathered(count, y.cols());
+            Dense gathered(count, y.cols());
             for (Eigen::Index i = 0; i < count; ++i) gathered.row(i) = y.row(sn.row_index[range.begin() + i]);
             sum.noalias() += l.block(range.begin(), j0, count, width).transpose() * gathered;
             return sum;
           },
-          [](const Eigen::MatrixXd& a, const Eigen::MatrixXd& c) -> Eigen::MatrixXd { return a + c; },
-          tbb::simple_partitioner());
+          [](const Dense& a, const Dense& c) -> Dense { return a + c; }, tbb::simple_partitioner());
       yj -= product;
     }
-    solve_in_place(l.block(j0, j0, width, width).triangularView<Eigen::Lower>().transpose(), yj);
+    solve_in_place(l.block(j0, j0, width, width).template triangularView<Eigen::Lower>().transpose(), yj);
   }
 }
 
 /// backward_supernode, on all threads for a large supernode.
-void backward_any_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
+template <typename Scalar>
+void backward_any_supernode(const SupernodeOf<Scalar>& sn, DenseMatrix<Scalar>& y) {
   if (sn.rows * sn.columns >= kParallelSupernodeEntries)
     backward_large_supernode(sn, y);
   else
@@ -157,22 +166,28 @@ void backward_any_supernode(const Supernode& sn, Eigen::MatrixXd& y) {
 }
 
 /// The supernode steps with Eigen's dense products: any number of columns (the sparse updates'
-/// hundreds of unit columns; one column takes Eigen's vector kernels).
-struct WideKernels {
-  using Matrix = Eigen::MatrixXd;
+/// hundreds of unit columns; one column takes Eigen's vector kernels), in the precision of the
+/// factor's values they read (ScalarType: double, or float for the single-precision copy).
+template <typename ScalarType>
+struct WideKernelsOf {
+  using Scalar = ScalarType;
+  using Matrix = DenseMatrix<Scalar>;
+  using Node = SupernodeOf<Scalar>;
   template <typename Subtract>
-  static void forward(const Supernode& sn, Matrix& y, const Subtract& subtract_below) {
+  static void forward(const Node& sn, Matrix& y, const Subtract& subtract_below) {
     forward_supernode(sn, y, subtract_below);
   }
-  static void forward_large(const Supernode& sn, Matrix& y) { forward_large_supernode(sn, y); }
-  static void backward(const Supernode& sn, Matrix& y) { backward_supernode(sn, y); }
-  static void backward_any(const Supernode& sn, Matrix& y) { backward_any_supernode(sn, y); }
+  static void forward_large(const Node& sn, Matrix& y) { forward_large_supernode(sn, y); }
+  static void backward(const Node& sn, Matrix& y) { backward_supernode(sn, y); }
+  static void backward_any(const Node& sn, Matrix& y) { backward_any_supernode(sn, y); }
 };
+using WideKernels = WideKernelsOf<double>;
 
 /// The same steps for K = 2 to 8 columns stored by rows, with the kernels of
 /// narrow_panel_kernels.hpp (they read the factor without copying it first).
 template <int K>
 struct NarrowKernels {
+  using Scalar = double;
   using Matrix = RhsRows;
   using Row = Eigen::Map<const Eigen::Matrix<double, 1, K>>;
 
@@ -378,19 +393,21 @@ SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
 }
 
 void SupernodalSubstitution::forward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
-  const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) { forward_with<decltype(kernels)>(factor, rows); });
-  if (!narrow) forward_with<WideKernels>(factor, y);
+  const bool narrow =
+      run_narrow(y, [&](auto kernels, RhsRows& rows) { forward_with<decltype(kernels)>(factor, values_of(factor), rows); });
+  if (!narrow) forward_with<WideKernels>(factor, values_of(factor), y);
 }
 
 void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::MatrixXd& y) const {
-  const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) { backward_with<decltype(kernels)>(factor, rows); });
-  if (!narrow) backward_with<WideKernels>(factor, y);
+  const bool narrow =
+      run_narrow(y, [&](auto kernels, RhsRows& rows) { backward_with<decltype(kernels)>(factor, values_of(factor), rows); });
+  if (!narrow) backward_with<WideKernels>(factor, values_of(factor), y);
 }
 
 template <typename Kernels>
-void SupernodalSubstitution::forward_with(const cholmod_factor& factor, typename Kernels::Matrix& y) const {
+void SupernodalSubstitution::forward_with(const cholmod_factor& factor, const typename Kernels::Scalar* values,
+                                          typename Kernels::Matrix& y) const {
   using Matrix = typename Kernels::Matrix;
-  const double* values = values_of(factor);
   // Forward: the subtrees in parallel; each one's updates of the rows above it go to its own
   // sums, subtracted in subtree order before the top supernodes run (the same rounding whatever
   // thread ran which subtree).
@@ -417,7 +434,7 @@ void SupernodalSubstitution::forward_with(const cholmod_factor& factor, typename
     if (sums.size() > 0)
       for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
   for (const int s : top_supernodes_) {
-    const Supernode sn = supernode_of(factor, values, s);
+    const auto sn = supernode_of(factor, values, s);
     if (sn.rows * sn.columns >= kParallelSupernodeEntries)
       Kernels::forward_large(sn, y);
     else
@@ -426,8 +443,8 @@ void SupernodalSubstitution::forward_with(const cholmod_factor& factor, typename
 }
 
 template <typename Kernels>
-void SupernodalSubstitution::backward_with(const cholmod_factor& factor, typename Kernels::Matrix& y) const {
-  const double* values = values_of(factor);
+void SupernodalSubstitution::backward_with(const cholmod_factor& factor, const typename Kernels::Scalar* values,
+                                           typename Kernels::Matrix& y) const {
   // Backward: the top supernodes from the root down, then the subtrees in parallel (each reads
   // the rows above it, already final, and writes only its own).
   for (auto it = top_supernodes_.rbegin(); it != top_supernodes_.rend(); ++it)
@@ -458,13 +475,40 @@ void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eige
 
   // Both sweeps on one copy by rows (2 to 8 columns), not a copy each.
   const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) {
-    forward_with<decltype(kernels)>(factor, rows);
-    backward_with<decltype(kernels)>(factor, rows);
+    forward_with<decltype(kernels)>(factor, values_of(factor), rows);
+    backward_with<decltype(kernels)>(factor, values_of(factor), rows);
   });
   if (!narrow) {
-    forward_with<WideKernels>(factor, y);
-    backward_with<WideKernels>(factor, y);
+    forward_with<WideKernels>(factor, values_of(factor), y);
+    backward_with<WideKernels>(factor, values_of(factor), y);
   }
+  for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
+}
+
+std::vector<float> SupernodalSubstitution::single_precision_values(const cholmod_factor& factor) const {
+  check_order(factor, static_cast<Eigen::Index>(order_));
+  const double* values = values_of(factor);
+  std::vector<float> out(factor.xsize);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, out.size(), std::size_t{1} << 16), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t i = r.begin(); i < r.end(); ++i) out[i] = static_cast<float>(values[i]);
+  });
+  return out;
+}
+
+void SupernodalSubstitution::solve_single(const cholmod_factor& factor, const std::vector<float>& values,
+                                          Eigen::Ref<Eigen::MatrixXf> b) const {
+  check_order(factor, b.rows());
+  if (values.size() != factor.xsize)
+    throw InputError(fmt::format("supernodal substitution: {} single-precision values for a factor of {}; expected a copy "
+                                 "made by single_precision_values of this factor",
+                                 values.size(), factor.xsize));
+  const auto* perm = static_cast<const int*>(factor.Perm);
+  const auto permuted = [&](Eigen::Index k) { return perm != nullptr ? perm[k] : k; };
+  const auto n = static_cast<Eigen::Index>(order_);
+  Eigen::MatrixXf y(n, b.cols());
+  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(permuted(k));
+  forward_with<WideKernelsOf<float>>(factor, values.data(), y);
+  backward_with<WideKernelsOf<float>>(factor, values.data(), y);
   for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
 }
 
