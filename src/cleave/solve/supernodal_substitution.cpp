@@ -62,6 +62,26 @@ SupernodeOf<Scalar> supernode_of(const cholmod_factor& f, const Scalar* values, 
 
 const double* values_of(const cholmod_factor& f) { return static_cast<const double*>(f.x); }
 
+/// Row k of the factor's order is row Perm[k] of the caller's (k itself without a permutation).
+Eigen::Index permuted_row(const cholmod_factor& f, Eigen::Index k) {
+  const auto* perm = static_cast<const int*>(f.Perm);
+  return perm != nullptr ? perm[k] : k;
+}
+
+/// The right-hand sides b in the factor's row order.
+template <typename Scalar, typename Rhs>
+DenseMatrix<Scalar> to_factor_order(const cholmod_factor& f, const Rhs& b) {
+  DenseMatrix<Scalar> y(b.rows(), b.cols());
+  for (Eigen::Index k = 0; k < y.rows(); ++k) y.row(k) = b.row(permuted_row(f, k));
+  return y;
+}
+
+/// b = y back in the caller's row order.
+template <typename Y, typename Rhs>
+void from_factor_order(const cholmod_factor& f, const Y& y, Rhs&& b) {
+  for (Eigen::Index k = 0; k < y.rows(); ++k) b.row(permuted_row(f, k)) = y.row(k);
+}
+
 /// Rows to give one parallel chunk of a panel `width` columns wide.
 Eigen::Index chunk_rows(Eigen::Index width) { return std::max<Eigen::Index>(64, kChunkEntries / std::max<Eigen::Index>(width, 1)); }
 
@@ -467,11 +487,7 @@ void SupernodalSubstitution::check_order(const cholmod_factor& factor, Eigen::In
 
 void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eigen::MatrixXd> b) const {
   check_order(factor, b.rows());
-  const auto* perm = static_cast<const int*>(factor.Perm);
-  const auto permuted = [&](Eigen::Index k) { return perm != nullptr ? perm[k] : k; };
-  const auto n = static_cast<Eigen::Index>(order_);
-  Eigen::MatrixXd y(n, b.cols());
-  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(permuted(k));
+  Eigen::MatrixXd y = to_factor_order<double>(factor, b);
 
   // Both sweeps on one copy by rows (2 to 8 columns), not a copy each.
   const bool narrow = run_narrow(y, [&](auto kernels, RhsRows& rows) {
@@ -482,7 +498,7 @@ void SupernodalSubstitution::solve(const cholmod_factor& factor, Eigen::Ref<Eige
     forward_with<WideKernels>(factor, values_of(factor), y);
     backward_with<WideKernels>(factor, values_of(factor), y);
   }
-  for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
+  from_factor_order(factor, y, b);
 }
 
 std::vector<float> SupernodalSubstitution::single_precision_values(const cholmod_factor& factor) const {
@@ -502,22 +518,15 @@ void SupernodalSubstitution::solve_single(const cholmod_factor& factor, const st
     throw InputError(fmt::format("supernodal substitution: {} single-precision values for a factor of {}; expected a copy "
                                  "made by single_precision_values of this factor",
                                  values.size(), factor.xsize));
-  const auto* perm = static_cast<const int*>(factor.Perm);
-  const auto permuted = [&](Eigen::Index k) { return perm != nullptr ? perm[k] : k; };
-  const auto n = static_cast<Eigen::Index>(order_);
-  Eigen::MatrixXf y(n, b.cols());
-  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(permuted(k));
+  Eigen::MatrixXf y = to_factor_order<float>(factor, b);
   forward_with<WideKernelsOf<float>>(factor, values.data(), y);
   backward_with<WideKernelsOf<float>>(factor, values.data(), y);
-  for (Eigen::Index k = 0; k < n; ++k) b.row(permuted(k)) = y.row(k);
+  from_factor_order(factor, y, b);
 }
 
 Eigen::MatrixXd SupernodalSubstitution::forward_of(const cholmod_factor& factor, const Eigen::MatrixXd& b) const {
   check_order(factor, b.rows());
-  const auto* perm = static_cast<const int*>(factor.Perm);
-  const auto n = static_cast<Eigen::Index>(order_);
-  Eigen::MatrixXd y(n, b.cols());
-  for (Eigen::Index k = 0; k < n; ++k) y.row(k) = b.row(perm != nullptr ? perm[k] : k);
+  Eigen::MatrixXd y = to_factor_order<double>(factor, b);
   forward(factor, y);
   return y;
 }
@@ -525,10 +534,8 @@ Eigen::MatrixXd SupernodalSubstitution::forward_of(const cholmod_factor& factor,
 Eigen::MatrixXd SupernodalSubstitution::backward_of(const cholmod_factor& factor, Eigen::MatrixXd y) const {
   check_order(factor, y.rows());
   backward(factor, y);
-  const auto* perm = static_cast<const int*>(factor.Perm);
-  const auto n = static_cast<Eigen::Index>(order_);
-  Eigen::MatrixXd b(n, y.cols());
-  for (Eigen::Index k = 0; k < n; ++k) b.row(perm != nullptr ? perm[k] : k) = y.row(k);
+  Eigen::MatrixXd b(y.rows(), y.cols());
+  from_factor_order(factor, y, b);
   return b;
 }
 
