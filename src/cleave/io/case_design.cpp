@@ -2,8 +2,6 @@
 
 #include <limits>
 
-#include "cleave/core/units.hpp"
-
 namespace cleave {
 namespace {
 
@@ -32,12 +30,10 @@ DesignControlPoint parse_control_point(const nlohmann::json& j, const JsonPath& 
   cp.position_mm = json_vec3(*position, at / "position");
   const nlohmann::json* langer = json_find(j, "langer_kPa");
   if (!langer) json_missing(at / "langer_kPa", "the eigenvalue along Langer's line (kPa)");
-  cp.langer_kPa = json_number_in(*langer, at / "langer_kPa", -units::kLargestStress_kPa, units::kLargestStress_kPa,
-                               "a finite stress in kPa, at most 1e9 in magnitude");
+  cp.langer_kPa = json_stress_kPa(*langer, at / "langer_kPa");
   const nlohmann::json* cross = json_find(j, "cross_kPa");
   if (!cross) json_missing(at / "cross_kPa", "the eigenvalue across Langer's line (kPa)");
-  cp.cross_kPa = json_number_in(*cross, at / "cross_kPa", -units::kLargestStress_kPa, units::kLargestStress_kPa,
-                               "a finite stress in kPa, at most 1e9 in magnitude");
+  cp.cross_kPa = json_stress_kPa(*cross, at / "cross_kPa");
   return cp;
 }
 

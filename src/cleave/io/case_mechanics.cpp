@@ -5,7 +5,6 @@
 #include <set>
 
 #include "cleave/core/error.hpp"
-#include "cleave/core/units.hpp"
 
 namespace cleave {
 namespace {
@@ -69,8 +68,7 @@ Vec6 parse_voigt_kPa(const nlohmann::json& value, const JsonPath& at) {
   if (!value.is_array() || value.size() != 6) json_error(at, value, kExpected);
   Vec6 s;
   for (std::size_t i = 0; i < 6; ++i)
-    s[static_cast<Eigen::Index>(i)] = json_number_in(value[i], at / i, -units::kLargestStress_kPa, units::kLargestStress_kPa,
-                                                     "a finite stress in kPa, at most 1e9 in magnitude");
+    s[static_cast<Eigen::Index>(i)] = json_stress_kPa(value[i], at / i);
   return s;
 }
 

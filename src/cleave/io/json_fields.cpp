@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
+#include "cleave/core/units.hpp"
 
 namespace cleave {
 namespace {
@@ -98,6 +99,12 @@ double json_number_in(const nlohmann::json& value, const JsonPath& at, double lo
   const double x = value.get<double>();
   if (!std::isfinite(x) || x < lo || x > hi) json_error(at, value, expected);
   return x;
+}
+
+double json_stress_kPa(const nlohmann::json& value, const JsonPath& at) {
+  static_assert(units::kLargestStress_kPa == 1e9, "the message below names the bound");
+  return json_number_in(value, at, -units::kLargestStress_kPa, units::kLargestStress_kPa,
+                        "a finite stress in kPa, at most 1e9 in magnitude");
 }
 
 int json_int_in(const nlohmann::json& value, const JsonPath& at, int lo, int hi) {

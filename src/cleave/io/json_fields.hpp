@@ -33,6 +33,8 @@ const nlohmann::json& json_object(const nlohmann::json& parent, const std::strin
 double json_number(const nlohmann::json& value, const JsonPath& at);
 /// A finite number in [lo, hi] (inclusive unless the bound is +-infinity).
 double json_number_in(const nlohmann::json& value, const JsonPath& at, double lo, double hi, const std::string& expected);
+/// A stress in kPa: finite and at most units::kLargestStress_kPa in magnitude (case files).
+double json_stress_kPa(const nlohmann::json& value, const JsonPath& at);
 int json_int_in(const nlohmann::json& value, const JsonPath& at, int lo, int hi);
 std::string json_string(const nlohmann::json& value, const JsonPath& at);
 bool json_bool(const nlohmann::json& value, const JsonPath& at);
