@@ -113,9 +113,15 @@ TEST_P(AbdomenEquilibration, TheAbdomenDesignConvergesAndTheFreeBodyStaysAtRest)
   const DesignResult result = design_residual_stress(m, d);
 
   // The equilibration stops at ||T sigma|| <= 5e-11 ||T sigma_d|| (its rounding floor lies between
-  // 1e-12 and 5e-11): measured 1.2e-11 (w_E = 0) and 3.7e-12 (w_E = 1) in this scale-free measure (2.05e-12
-  // with w_E = 1 while it iterated to the floor); the body's rest and Hoger's mean are checked below.
-  EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 5e-11 : 1e-11);
+  // 1e-12 and 5e-11). In the scale-free measure, relative to ||sigma||, that is up to ~6e-10 for
+  // the default design (w_E = 0), which relaxes on the free shell to a sigma much smaller than
+  // sigma_d: measured 4.8e-10 where CG stops just below the rule (4.1e-11 of the forces), 1.2e-11
+  // where a double step overshot it; with w_E = 1, 6e-13 to 3.7e-12. The body's rest and Hoger's
+  // mean are checked below.
+  const double force_reduction = residual_stress_forces(m.volume, result.stress_kPa).norm() /
+                                 residual_stress_forces(m.volume, result.designed_kPa).norm();
+  EXPECT_LT(force_reduction, 5e-11);
+  EXPECT_LT(result.residual_final, GetParam() == 0.0 ? 1e-9 : 1e-11);
   EXPECT_GT(result.residual_designed, 1e-2);
   const double size = m.size_mm();
   EXPECT_GT(max_displacement_mm(m, result.designed_kPa), 1e-3 * size);

@@ -5,6 +5,8 @@
 // reach the tolerance.
 #include <gtest/gtest.h>
 
+#include <cstdio>
+
 #include <Eigen/SparseCholesky>
 #include <algorithm>
 #include <vector>
@@ -228,4 +230,30 @@ TEST(SparseCholeskyUpdate, TooManyChangedRowsFallBackToTheCaller) {
 }
 
 }  // namespace
+// The equilibration's CG preconditions with a single-precision copy of the factor: it solves to
+// about the float rounding times the condition number, and a refactorization (same pattern, new
+// values) replaces the copy, so a solve never uses the values of an earlier matrix.
+TEST(SparseCholesky, SolvesInSinglePrecisionWithTheCurrentFactorsFloatCopy) {
+  const std::vector<int> first{5, 300, 1200};
+  const std::vector<int> second{17, 900};
+  const Eigen::SparseMatrix<double> a = design_system(kSide, first, kConstraint);
+  const Eigen::SparseMatrix<double> a2 = design_system(kSide, second, kConstraint);
+  const Eigen::VectorXd b = targets(kCells, first, kConstraint).col(0) + Eigen::VectorXd::Ones(kCells);
+  SparseCholesky chol;
+  chol.factorize(a);
+  const Eigen::VectorXd exact = chol.solve(b);
+  const Eigen::VectorXd single = chol.solve_single_precision(b);
+  const double error = relative_error(single, exact);
+  std::printf("single-precision solve: relative error %.2e\n", error);
+  EXPECT_LT(error, 1e-5);  // measured 2.7e-7
+  EXPECT_GT(error, 1e-12);  // rounded in float, not the double factor's solve
+
+  chol.factorize(a2);
+  const Eigen::VectorXd exact2 = Eigen::SimplicialLDLT<Eigen::SparseMatrix<double>>(a2).solve(b);
+  ASSERT_GT(relative_error(exact2, exact), 1e-2);
+  const double error2 = relative_error(chol.solve_single_precision(b), exact2);
+  std::printf("after the refactorization: relative error %.2e\n", error2);
+  EXPECT_LT(error2, 1e-5);  // a stale copy would be off by more than 1e-2
+}
+
 }  // namespace cleave

@@ -178,6 +178,7 @@ struct SparseCholesky::Impl {
   std::vector<int> outer;
   std::vector<int> inner;
   bool analyzed = false;
+  std::vector<float> single_values;  ///< the factor's values in float (solve_single_precision), made on first use
   std::vector<double> values;     ///< the factorized matrix's values (pattern: outer, inner)
   double factor_seconds = 0;      ///< wall time of the last numeric factorization
   double solve_seconds = 0;       ///< wall time of one solve with the factor (one column), last measured
@@ -246,6 +247,7 @@ void SparseCholesky::factorize(const Eigen::SparseMatrix<double>& a) {
   impl_->factor_seconds = seconds_between(start, Clock::now());
   if (!impl_->substitution) impl_->substitution.emplace(*impl_->llt.factor());
   impl_->values.assign(a.valuePtr(), a.valuePtr() + a.nonZeros());
+  impl_->single_values.clear();
   impl_->diagonal = a.diagonal();
   impl_->low_rank_columns.resize(0, 0);
   impl_->low_rank_row.clear();
@@ -628,6 +630,16 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
   if (impl_->llt.info() != Eigen::Success || !x.allFinite())
     throw ComputeError("sparse Cholesky solve failed or produced a non-finite value");
   return x;
+}
+
+Eigen::VectorXd SparseCholesky::solve_single_precision(const Eigen::VectorXd& b) const {
+  if (!impl_->substitution) return solve(b);
+  if (impl_->single_values.empty()) impl_->single_values = impl_->substitution->single_precision_values(*impl_->llt.factor());
+  Eigen::MatrixXf x = b.cast<float>();
+  impl_->substitution->solve_single(*impl_->llt.factor(), impl_->single_values, x);
+  Eigen::VectorXd out = x.cast<double>();
+  if (!out.allFinite()) throw ComputeError("sparse Cholesky solve in single precision produced a non-finite value");
+  return out;
 }
 
 }  // namespace cleave

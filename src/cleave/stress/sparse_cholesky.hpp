@@ -24,6 +24,12 @@ class SparseCholesky {
 
   void factorize(const Eigen::SparseMatrix<double>& a);
   Eigen::MatrixXd solve(const Eigen::MatrixXd& b) const;
+  /// a0^-1 b with a single-precision copy of the factor (made by the first call after each
+  /// factorization: half the factor's bytes to keep and to stream, so about half the time of
+  /// solve). Its error is about the float rounding times the condition number: for a
+  /// preconditioner whose result is checked in double (the equilibration's CG), not as a solve.
+  /// ComputeError for a non-finite result.
+  Eigen::VectorXd solve_single_precision(const Eigen::VectorXd& b) const;
   /// Same, followed by kRefinementSteps of iterative refinement against `a` (the factorized
   /// matrix): the design systems (L^T L, condition ~ n^2) lose digits in a plain solve.
   Eigen::MatrixXd solve_refined(const Eigen::SparseMatrix<double>& a, const Eigen::MatrixXd& b) const;
