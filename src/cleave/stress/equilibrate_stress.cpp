@@ -134,8 +134,15 @@ struct StressEquilibrator::Impl {
     // edit's second step needs a reduction of 10-1000, which it gives); then from the best
     // iterate with the double factor, whose accuracy the near-singular modes need for more.
     bool single = true;
-    const auto precondition = [&](const Vector& residual) {
-      return single ? cholesky.solve_single_precision(residual) : Vector(cholesky.solve(residual));
+    const auto precondition = [&](const Vector& residual) -> Vector {
+      if (single) {
+        try {
+          return cholesky.solve_single_precision(residual);
+        } catch (const ComputeError&) {
+          single = false;  // beyond float's range: the double factor from here on
+        }
+      }
+      return cholesky.solve(residual);
     };
     z = precondition(r);
     Vector p = z;
