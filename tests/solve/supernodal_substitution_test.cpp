@@ -183,16 +183,16 @@ TEST(SupernodalSubstitution, SolvesInSinglePrecisionWithTheFactorsFloatCopy) {
   for (std::size_t i = 0; i < values.size(); i += 997) EXPECT_EQ(values[i], static_cast<float>(exact[i]));
 
   const Eigen::MatrixXd reference = chol.cholmod_solution(s.b);
-  Eigen::MatrixXf x = s.b.cast<float>();
+  Eigen::MatrixXd x = s.b;
   sub.solve_single(chol.factor(), values, x);
-  const double error = relative_difference(x.cast<double>(), reference);
+  const double error = relative_difference(x, reference);
   EXPECT_LT(error, 1e-4);   // measured 1.0e-7
   EXPECT_GT(error, 1e-10);  // float arithmetic, not the double factor
   // Several columns (the wide kernels) solve each column alike.
   const Eigen::MatrixXd several = Eigen::MatrixXd::Random(s.a.rows(), 3);
-  Eigen::MatrixXf several_x = several.cast<float>();
+  Eigen::MatrixXd several_x = several;
   sub.solve_single(chol.factor(), values, several_x);
-  EXPECT_LT(relative_difference(several_x.cast<double>(), chol.cholmod_solution(several)), 1e-4);
+  EXPECT_LT(relative_difference(several_x, chol.cholmod_solution(several)), 1e-4);
 
   const std::vector<float> short_copy(values.begin(), values.end() - 1);
   try {

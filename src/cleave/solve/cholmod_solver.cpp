@@ -124,12 +124,12 @@ class CholmodSolver final : public LinearSolver {
     Vector trial = Vector::Zero(b.size());
     r = b;
     for (int step = 0; step < kMaxSingleSubstitutions; ++step) {
-      Eigen::VectorXf correction = r.cast<float>();
-      if (!correction.allFinite()) return false;
+      if (!r.cast<float>().allFinite()) return false;
+      Vector correction = r;
       substitution_->solve_single(*factor_, single_values_, correction);
       ++report.iterations;
       if (!correction.allFinite()) return false;
-      trial += correction.cast<double>();
+      trial += correction;
       residual(a_, b, trial, r);
       report.relative_residual = r.norm() / b_norm;
       if (report.relative_residual <= settings_.relative_tolerance) {

@@ -11,6 +11,7 @@
 #include <algorithm>
 #include <cstdint>
 #include <queue>
+#include <type_traits>
 #include <utility>
 
 #include "cleave/core/error.hpp"
@@ -68,18 +69,19 @@ Eigen::Index permuted_row(const cholmod_factor& f, Eigen::Index k) {
   return perm != nullptr ? perm[k] : k;
 }
 
-/// The right-hand sides b in the factor's row order.
+/// The right-hand sides b in the factor's row order, in the precision Scalar.
 template <typename Scalar, typename Rhs>
 DenseMatrix<Scalar> to_factor_order(const cholmod_factor& f, const Rhs& b) {
   DenseMatrix<Scalar> y(b.rows(), b.cols());
-  for (Eigen::Index k = 0; k < y.rows(); ++k) y.row(k) = b.row(permuted_row(f, k));
+  for (Eigen::Index k = 0; k < y.rows(); ++k) y.row(k) = b.row(permuted_row(f, k)).template cast<Scalar>();
   return y;
 }
 
-/// b = y back in the caller's row order.
+/// b = y back in the caller's row order (and precision).
 template <typename Y, typename Rhs>
 void from_factor_order(const cholmod_factor& f, const Y& y, Rhs&& b) {
-  for (Eigen::Index k = 0; k < y.rows(); ++k) b.row(permuted_row(f, k)) = y.row(k);
+  using Scalar = typename std::decay_t<Rhs>::Scalar;
+  for (Eigen::Index k = 0; k < y.rows(); ++k) b.row(permuted_row(f, k)) = y.row(k).template cast<Scalar>();
 }
 
 /// Rows to give one parallel chunk of a panel `width` columns wide.
@@ -512,7 +514,7 @@ std::vector<float> SupernodalSubstitution::single_precision_values(const cholmod
 }
 
 void SupernodalSubstitution::solve_single(const cholmod_factor& factor, const std::vector<float>& values,
-                                          Eigen::Ref<Eigen::MatrixXf> b) const {
+                                          Eigen::Ref<Eigen::MatrixXd> b) const {
   check_order(factor, b.rows());
   if (values.size() != factor.xsize)
     throw InputError(fmt::format("supernodal substitution: {} single-precision values for a factor of {}; expected a copy "

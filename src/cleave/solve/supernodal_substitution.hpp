@@ -37,11 +37,14 @@ class SupernodalSubstitution {
   /// InputError when the factor does not fit this schedule.
   std::vector<float> single_precision_values(const cholmod_factor_struct& factor) const;
   /// b <- A^-1 b in single precision with `values` (single_precision_values of this factor, or of
-  /// a refactorization with the same analysis): the relative error is about the float rounding
-  /// times the condition number (4.6e-5 on the incised abdomen at 45k cells, 1e-6 on the tube), so
-  /// callers check the residual in double and refine (CholmodSolver). Wide kernels only.
-  /// InputError when b's row count or the size of `values` does not fit the factor.
-  void solve_single(const cholmod_factor_struct& factor, const std::vector<float>& values, Eigen::Ref<Eigen::MatrixXf> b) const;
+  /// a refactorization with the same analysis): b is rounded to float as it is permuted into the
+  /// factor's order and the float result widened back. The relative error is about the float
+  /// rounding times the condition number (4.6e-5 on the incised abdomen at 45k cells, 1e-6 on the
+  /// tube), so callers check the residual in double and refine (CholmodSolver) or precondition
+  /// with it (SparseCholesky::solve_single_precision). A b beyond float's range gives non-finite
+  /// values. Wide kernels only. InputError when b's row count or the size of `values` does not
+  /// fit the factor.
+  void solve_single(const cholmod_factor_struct& factor, const std::vector<float>& values, Eigen::Ref<Eigen::MatrixXd> b) const;
 
   /// W = L^-1 P E for the unit columns E = [e_r ...] of the (unpermuted) rows `rows`: what the
   /// forward substitution makes of them. Only the supernodes on the paths from those rows'

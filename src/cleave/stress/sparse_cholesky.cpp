@@ -635,11 +635,10 @@ Eigen::MatrixXd SparseCholesky::solve(const Eigen::MatrixXd& b) const {
 Eigen::VectorXd SparseCholesky::solve_single_precision(const Eigen::VectorXd& b) const {
   if (!impl_->substitution) return solve(b);
   if (impl_->single_values.empty()) impl_->single_values = impl_->substitution->single_precision_values(*impl_->llt.factor());
-  Eigen::MatrixXf x = b.cast<float>();
+  Eigen::VectorXd x = b;
   impl_->substitution->solve_single(*impl_->llt.factor(), impl_->single_values, x);
-  Eigen::VectorXd out = x.cast<double>();
-  if (!out.allFinite()) throw ComputeError("sparse Cholesky solve in single precision produced a non-finite value");
-  return out;
+  if (!x.allFinite()) throw ComputeError("sparse Cholesky solve in single precision produced a non-finite value");
+  return x;
 }
 
 }  // namespace cleave
