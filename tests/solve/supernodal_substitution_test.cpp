@@ -9,6 +9,7 @@
 #include <fmt/format.h>
 #include <gtest/gtest.h>
 #include <tbb/global_control.h>
+#include <tbb/task_arena.h>
 
 #include "cleave/core/error.hpp"
 #include "cholmod_test_factor.hpp"
@@ -148,6 +149,28 @@ TEST(SupernodalSubstitution, UnitColumnsReachOnlyTheSupernodesAboveThem) {
     FAIL() << "expected InputError";
   } catch (const InputError& err) {
     EXPECT_EQ(std::string(err.what()), fmt::format("supernodal substitution: row -1 is outside 0 to {}", n - 1));
+  }
+}
+
+// A dragged stroke's tens of unit columns are split into one block of columns per thread: in an
+// arena of two threads (whatever this machine has) and of one, W is L^-1 P E on the reached rows.
+TEST(SupernodalSubstitution, ManyUnitColumnsSplitOverThreadsGiveTheSameColumns) {
+  test::LinearSystem s = block_system();
+  test::CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  const Eigen::Index n = s.a.rows();
+  std::vector<Eigen::Index> rows;
+  for (Eigen::Index k = 0; k < 40; ++k) rows.push_back(n - 1 - 7 * k);  // 40 columns: two blocks of 20
+  Eigen::MatrixXd e = Eigen::MatrixXd::Zero(n, static_cast<Eigen::Index>(rows.size()));
+  for (std::size_t c = 0; c < rows.size(); ++c) e(rows[c], static_cast<Eigen::Index>(c)) = 1.0;
+  const Eigen::MatrixXd reference = sub.forward_of(chol.factor(), e);
+  for (const int threads : {2, 1}) {
+    std::vector<Eigen::Index> reached;
+    Eigen::MatrixXd w;
+    tbb::task_arena(threads).execute([&] { w = sub.forward_unit_columns(chol.factor(), rows, reached); });
+    Eigen::MatrixXd w_full = Eigen::MatrixXd::Zero(n, w.cols());
+    for (std::size_t i = 0; i < reached.size(); ++i) w_full.row(reached[i]) = w.row(static_cast<Eigen::Index>(i));
+    EXPECT_LT(relative_difference(w_full, reference), 1e-13) << threads << " thread(s)";
   }
 }
 

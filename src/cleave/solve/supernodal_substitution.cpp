@@ -27,6 +27,8 @@ constexpr Eigen::Index kParallelSupernodeEntries = Eigen::Index{1} << 16;
 /// Columns per block of a large supernode: each block's small triangle is solved on one thread,
 /// the rows below it over all.
 constexpr Eigen::Index kColumnBlock = 128;
+/// Columns per thread below which a forward substitution of many columns keeps them together.
+constexpr Eigen::Index kMinColumnsPerBlock = 8;
 /// Entries of a large supernode's panel per parallel chunk of rows.
 constexpr Eigen::Index kChunkEntries = Eigen::Index{1} << 15;
 
@@ -340,6 +342,27 @@ void forward_in_order(const std::vector<Supernode>& supernodes, typename Kernels
   }
 }
 
+/// forward_in_order with the wide kernels, the columns of y split into one block per thread:
+/// the columns are independent, and a stroke's tens of unit columns made the supernodes' small
+/// triangles and products run on one thread (only the large supernodes' rows were shared out).
+/// The blocks depend only on the thread count, so the same machine gives the same bits.
+void forward_in_order_by_column_blocks(const std::vector<Supernode>& supernodes, Eigen::MatrixXd& y) {
+  const Eigen::Index threads = std::max(1, tbb::this_task_arena::max_concurrency());
+  const Eigen::Index blocks = std::min(threads, y.cols() / kMinColumnsPerBlock);
+  if (blocks < 2) return forward_in_order<WideKernels>(supernodes, y);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, blocks, 1),
+                    [&](const tbb::blocked_range<Eigen::Index>& range) {
+                      for (Eigen::Index block = range.begin(); block < range.end(); ++block) {
+                        const Eigen::Index first = block * y.cols() / blocks;
+                        const Eigen::Index count = (block + 1) * y.cols() / blocks - first;
+                        Eigen::MatrixXd part = y.middleCols(first, count);
+                        forward_in_order<WideKernels>(supernodes, part);
+                        y.middleCols(first, count) = part;
+                      }
+                    },
+                    tbb::simple_partitioner());
+}
+
 }  // namespace
 
 SupernodalSubstitution::SupernodalSubstitution(const cholmod_factor& factor) {
@@ -582,7 +605,7 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
   for (std::size_t i = 0; i < rows.size(); ++i)
     w.row(slot[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(rows[i])])]) += b_rows.row(static_cast<Eigen::Index>(i));
   if (!run_narrow(w, [&](auto kernels, RhsRows& by_rows) { forward_in_order<decltype(kernels)>(compact, by_rows); }))
-    forward_in_order<WideKernels>(compact, w);
+    forward_in_order_by_column_blocks(compact, w);
   return w;
 }
 
