@@ -228,6 +228,33 @@ TEST(SupernodalSubstitution, SolvesInSinglePrecisionWithTheFactorsFloatCopy) {
   }
 }
 
+// A load on a few rows (the incisions' released traction): the forward sweep skips the
+// supernodes below none of them, whose rows stay zero, so the result is solve_single's bit for
+// bit; entries outside the support are not read.
+TEST(SupernodalSubstitution, SolvesALoadOnFewRowsLikeTheWholeSolveVisitingOnlyTheSupernodesAboveThem) {
+  test::LinearSystem s = block_system();
+  test::CholmodFactor chol(s.a);
+  const SupernodalSubstitution sub(chol.factor());
+  const std::vector<float> values = sub.single_precision_values(chol.factor());
+  const Eigen::Index n = s.a.rows();
+  const std::vector<Eigen::Index> support = {3, 4, 5, 100, 101, 102, n / 2, n - 10};
+  Eigen::MatrixXd b = Eigen::MatrixXd::Zero(n, 1);
+  for (const Eigen::Index r : support) b(r, 0) = 1.0 + 0.01 * static_cast<double>(r);
+  Eigen::MatrixXd whole = b;
+  sub.solve_single(chol.factor(), values, whole);
+  Eigen::MatrixXd supported = Eigen::MatrixXd::Constant(n, 1, 1e3);  // not read outside the support
+  for (const Eigen::Index r : support) supported(r, 0) = b(r, 0);
+  sub.solve_single_supported(chol.factor(), values, support, supported);
+  EXPECT_TRUE(supported == whole);
+  EXPECT_LT(relative_difference(supported, chol.cholmod_solution(b)), 1e-4);
+  try {
+    sub.solve_single_supported(chol.factor(), values, {n}, supported);
+    FAIL() << "expected InputError";
+  } catch (const InputError& err) {
+    EXPECT_EQ(std::string(err.what()), fmt::format("supernodal substitution: row {} is outside 0 to {}", n, n - 1));
+  }
+}
+
 TEST(SupernodalSubstitution, RejectsARightHandSideOfAnotherSize) {
   test::LinearSystem s = test::clamped_system(test::make_box(Vec3i{3, 2, 2}, 1.0), test::Clamp::left_end);
   test::CholmodFactor chol(s.a);

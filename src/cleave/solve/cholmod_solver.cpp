@@ -4,6 +4,7 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
 #include <utility>
 #include <optional>
 #include <vector>
@@ -18,6 +19,39 @@ namespace {
 /// Substitutions with the single-precision factor before the double one takes over: one refinement
 /// takes the incised 44k tube from a residual of 1.2e-5 to 2.5e-11 to 7.6e-11 (session 28).
 constexpr int kMaxSingleSubstitutions = 3;
+
+/// The first single-precision substitution leaves out b's smallest entries while their norm
+/// stays below this share of the tolerance times ||b||: its forward sweep then visits only the
+/// supernodes above the rest. The residual is checked against the whole b (and refined if need be).
+constexpr double kDroppedShareOfTolerance = 1e-2;
+/// A support of more than this share of the rows is solved whole (it would reach most supernodes).
+constexpr double kSupportedShare = 0.5;
+
+/// The rows of b left when its smallest entries are left out while their norm stays at most
+/// `dropped_norm` (by binary exponent: every entry below 2^k, for the largest k whose entries fit),
+/// or none (solve b whole) when that leaves more than kSupportedShare of the rows.
+std::vector<Eigen::Index> load_support(const Vector& b, double dropped_norm) {
+  constexpr int kShift = 1080;  // frexp's exponents of doubles (-1073 to 1024) shifted to >= 0
+  constexpr int kExponents = 2110;
+  std::vector<int> exponent_of(static_cast<std::size_t>(b.size()));
+  std::vector<double> square_sum(kExponents, 0.0);
+  for (Eigen::Index i = 0; i < b.size(); ++i) {
+    int exponent = 0;
+    std::frexp(b[i], &exponent);
+    const int bucket = std::clamp(exponent + kShift, 0, kExponents - 1);
+    exponent_of[static_cast<std::size_t>(i)] = bucket;
+    square_sum[static_cast<std::size_t>(bucket)] += b[i] * b[i];
+  }
+  double dropped = 0.0;
+  int kept_from = 0;  // the entries of the buckets below are left out
+  while (kept_from < kExponents && dropped + square_sum[static_cast<std::size_t>(kept_from)] <= dropped_norm * dropped_norm)
+    dropped += square_sum[static_cast<std::size_t>(kept_from++)];
+  std::vector<Eigen::Index> support;
+  for (Eigen::Index i = 0; i < b.size(); ++i)
+    if (b[i] != 0.0 && exponent_of[static_cast<std::size_t>(i)] >= kept_from) support.push_back(i);
+  if (static_cast<double>(support.size()) > kSupportedShare * static_cast<double>(b.size())) support.clear();
+  return support;
+}
 
 class CholmodSolver final : public LinearSolver {
  public:
@@ -126,7 +160,12 @@ class CholmodSolver final : public LinearSolver {
     for (int step = 0; step < kMaxSingleSubstitutions; ++step) {
       if (!r.cast<float>().allFinite()) return false;
       Vector correction = r;
-      substitution_->solve_single(*factor_, single_values_, correction);
+      const std::vector<Eigen::Index> support =
+          step == 0 ? load_support(r, kDroppedShareOfTolerance * settings_.relative_tolerance * b_norm) : std::vector<Eigen::Index>{};
+      if (support.empty())
+        substitution_->solve_single(*factor_, single_values_, correction);
+      else
+        substitution_->solve_single_supported(*factor_, single_values_, support, correction);
       ++report.iterations;
       if (!correction.allFinite()) return false;
       trial += correction;

@@ -451,7 +451,8 @@ void SupernodalSubstitution::backward(const cholmod_factor& factor, Eigen::Matri
 
 template <typename Kernels>
 void SupernodalSubstitution::forward_with(const cholmod_factor& factor, const typename Kernels::Scalar* values,
-                                          typename Kernels::Matrix& y) const {
+                                          typename Kernels::Matrix& y, const std::vector<std::uint8_t>* reached) const {
+  const auto visits = [&](int s) { return reached == nullptr || (*reached)[static_cast<std::size_t>(s)] != 0; };
   using Matrix = typename Kernels::Matrix;
   // Forward: the subtrees in parallel; each one's updates of the rows above it go to its own
   // sums, subtracted in subtree order before the top supernodes run (the same rounding whatever
@@ -462,7 +463,8 @@ void SupernodalSubstitution::forward_with(const cholmod_factor& factor, const ty
                     [&](const tbb::blocked_range<std::size_t>& range) {
                       for (std::size_t t = range.begin(); t < range.end(); ++t) {
                         Matrix& sums = above[t];  // made at its first update: a root (a held dof) has none
-                        for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i)
+                        for (std::size_t i = subtree_begin_[t]; i < subtree_begin_[t + 1]; ++i) {
+                          if (!visits(subtree_order_[i])) continue;
                           Kernels::forward(supernode_of(factor, values, subtree_order_[i]), y, [&](int row, const auto& update) {
                             const int slot = top_slot_of_row_[static_cast<std::size_t>(row)];
                             if (slot >= 0) {
@@ -472,6 +474,7 @@ void SupernodalSubstitution::forward_with(const cholmod_factor& factor, const ty
                               y.row(row) -= update;
                             }
                           });
+                        }
                       }
                     },
                     tbb::simple_partitioner());
@@ -479,6 +482,7 @@ void SupernodalSubstitution::forward_with(const cholmod_factor& factor, const ty
     if (sums.size() > 0)
       for (Eigen::Index slot = 0; slot < top_rows; ++slot) y.row(row_of_top_slot_[static_cast<std::size_t>(slot)]) -= sums.row(slot);
   for (const int s : top_supernodes_) {
+    if (!visits(s)) continue;
     const auto sn = supernode_of(factor, values, s);
     if (sn.rows * sn.columns >= kParallelSupernodeEntries)
       Kernels::forward_large(sn, y);
@@ -536,15 +540,31 @@ std::vector<float> SupernodalSubstitution::single_precision_values(const cholmod
   return out;
 }
 
-void SupernodalSubstitution::solve_single(const cholmod_factor& factor, const std::vector<float>& values,
-                                          Eigen::Ref<Eigen::MatrixXd> b) const {
-  check_order(factor, b.rows());
+void SupernodalSubstitution::check_single_values(const cholmod_factor& factor, const std::vector<float>& values) const {
   if (values.size() != factor.xsize)
     throw InputError(fmt::format("supernodal substitution: {} single-precision values for a factor of {}; expected a copy "
                                  "made by single_precision_values of this factor",
                                  values.size(), factor.xsize));
+}
+
+void SupernodalSubstitution::solve_single(const cholmod_factor& factor, const std::vector<float>& values,
+                                          Eigen::Ref<Eigen::MatrixXd> b) const {
+  check_order(factor, b.rows());
+  check_single_values(factor, values);
   Eigen::MatrixXf y = to_factor_order<float>(factor, b);
   forward_with<WideKernelsOf<float>>(factor, values.data(), y);
+  backward_with<WideKernelsOf<float>>(factor, values.data(), y);
+  from_factor_order(factor, y, b);
+}
+
+void SupernodalSubstitution::solve_single_supported(const cholmod_factor& factor, const std::vector<float>& values,
+                                                    const std::vector<Eigen::Index>& support, Eigen::Ref<Eigen::MatrixXd> b) const {
+  check_order(factor, b.rows());
+  check_single_values(factor, values);
+  const std::vector<std::uint8_t> reached = supernodes_above_mask(support);
+  Eigen::MatrixXf y = Eigen::MatrixXf::Zero(b.rows(), b.cols());
+  for (const Eigen::Index r : support) y.row(inverse_permutation_[static_cast<std::size_t>(r)]) = b.row(r).cast<float>();
+  forward_with<WideKernelsOf<float>>(factor, values.data(), y, &reached);
   backward_with<WideKernelsOf<float>>(factor, values.data(), y);
   from_factor_order(factor, y, b);
 }
@@ -607,6 +627,12 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
   if (!run_narrow(w, [&](auto kernels, RhsRows& by_rows) { forward_in_order<decltype(kernels)>(compact, by_rows); }))
     forward_in_order_by_column_blocks(compact, w);
   return w;
+}
+
+std::vector<std::uint8_t> SupernodalSubstitution::supernodes_above_mask(const std::vector<Eigen::Index>& rows) const {
+  std::vector<std::uint8_t> reached(supernode_count_, 0);
+  for (const int s : supernodes_above(rows)) reached[static_cast<std::size_t>(s)] = 1;
+  return reached;
 }
 
 std::vector<int> SupernodalSubstitution::supernodes_above(const std::vector<Eigen::Index>& rows) const {

@@ -16,6 +16,7 @@
 // not depend on which thread ran what: the same schedule gives the same bits.
 #include <Eigen/Core>
 #include <cstddef>
+#include <cstdint>
 #include <vector>
 
 struct cholmod_factor_struct;
@@ -45,6 +46,13 @@ class SupernodalSubstitution {
   /// values. Wide kernels only. InputError when b's row count or the size of `values` does not
   /// fit the factor.
   void solve_single(const cholmod_factor_struct& factor, const std::vector<float>& values, Eigen::Ref<Eigen::MatrixXd> b) const;
+  /// solve_single for a b that is zero outside the (unpermuted) rows `support`: the forward
+  /// substitution visits only the supernodes above those rows (the others' rows of L^-1 P b are
+  /// zero, so skipping them is exact), the back substitution all. A load that lives near a few
+  /// incisions reaches a part of the factor's many small leaf supernodes. Entries of b outside
+  /// `support` are not read (taken as zero). InputError as solve_single, and for rows out of range.
+  void solve_single_supported(const cholmod_factor_struct& factor, const std::vector<float>& values,
+                              const std::vector<Eigen::Index>& support, Eigen::Ref<Eigen::MatrixXd> b) const;
 
   /// W = L^-1 P E for the unit columns E = [e_r ...] of the (unpermuted) rows `rows`: what the
   /// forward substitution makes of them. Only the supernodes on the paths from those rows'
@@ -81,8 +89,11 @@ class SupernodalSubstitution {
   /// forward and backward with the supernode steps of `Kernels` (Eigen's products, or the
   /// narrow kernels on right-hand sides stored by rows); defined and used in the .cpp only.
   /// `values`: the factor's own (double) or a single-precision copy, as the kernels read.
+  /// `reached`: when not null, only the supernodes it marks (those above the right-hand side's
+  /// non-zero rows; the others would add zeros).
   template <typename Kernels>
-  void forward_with(const cholmod_factor_struct& factor, const typename Kernels::Scalar* values, typename Kernels::Matrix& y) const;
+  void forward_with(const cholmod_factor_struct& factor, const typename Kernels::Scalar* values, typename Kernels::Matrix& y,
+                    const std::vector<std::uint8_t>* reached = nullptr) const;
   template <typename Kernels>
   void backward_with(const cholmod_factor_struct& factor, const typename Kernels::Scalar* values, typename Kernels::Matrix& y) const;
 
@@ -99,8 +110,12 @@ class SupernodalSubstitution {
   std::vector<int> supernode_of_column_;
   std::vector<int> inverse_permutation_;  ///< permuted position of each original row
   void check_order(const cholmod_factor_struct& factor, Eigen::Index rows) const;
+  /// InputError unless `values` has the factor's size (a single_precision_values copy).
+  void check_single_values(const cholmod_factor_struct& factor, const std::vector<float>& values) const;
   /// The supernodes on the paths from the (unpermuted) rows' supernodes to the roots, ascending.
   std::vector<int> supernodes_above(const std::vector<Eigen::Index>& rows) const;
+  /// The same as a mark per supernode.
+  std::vector<std::uint8_t> supernodes_above_mask(const std::vector<Eigen::Index>& rows) const;
 };
 
 }  // namespace cleave
