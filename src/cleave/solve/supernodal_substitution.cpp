@@ -630,26 +630,24 @@ Eigen::MatrixXd SupernodalSubstitution::forward_sparse(const cholmod_factor& fac
 }
 
 std::vector<std::uint8_t> SupernodalSubstitution::supernodes_above_mask(const std::vector<Eigen::Index>& rows) const {
+  const auto n = static_cast<Eigen::Index>(order_);
+  // Each row's supernode and all above it (the rows below a supernode's columns belong to its
+  // ancestors); a path ends where an earlier row's path was.
   std::vector<std::uint8_t> reached(supernode_count_, 0);
-  for (const int s : supernodes_above(rows)) reached[static_cast<std::size_t>(s)] = 1;
+  for (const Eigen::Index r : rows) {
+    if (r < 0 || r >= n) throw InputError(fmt::format("supernodal substitution: row {} is outside 0 to {}", r, n - 1));
+    for (int s = supernode_of_column_[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(r)])];
+         s >= 0 && reached[static_cast<std::size_t>(s)] == 0; s = parent_[static_cast<std::size_t>(s)])
+      reached[static_cast<std::size_t>(s)] = 1;
+  }
   return reached;
 }
 
 std::vector<int> SupernodalSubstitution::supernodes_above(const std::vector<Eigen::Index>& rows) const {
-  const auto n = static_cast<Eigen::Index>(order_);
-  // Each row's supernode and all above it (the rows below a supernode's columns belong to its
-  // ancestors), in elimination order.
-  std::vector<std::uint8_t> reached(supernode_count_, 0);
-  std::vector<int> visit;
-  for (const Eigen::Index r : rows) {
-    if (r < 0 || r >= n) throw InputError(fmt::format("supernodal substitution: row {} is outside 0 to {}", r, n - 1));
-    for (int s = supernode_of_column_[static_cast<std::size_t>(inverse_permutation_[static_cast<std::size_t>(r)])];
-         s >= 0 && reached[static_cast<std::size_t>(s)] == 0; s = parent_[static_cast<std::size_t>(s)]) {
-      reached[static_cast<std::size_t>(s)] = 1;
-      visit.push_back(s);
-    }
-  }
-  std::sort(visit.begin(), visit.end());
+  const std::vector<std::uint8_t> reached = supernodes_above_mask(rows);
+  std::vector<int> visit;  // in elimination order
+  for (std::size_t s = 0; s < reached.size(); ++s)
+    if (reached[s] != 0) visit.push_back(static_cast<int>(s));
   return visit;
 }
 

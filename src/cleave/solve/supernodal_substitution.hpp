@@ -112,10 +112,11 @@ class SupernodalSubstitution {
   void check_order(const cholmod_factor_struct& factor, Eigen::Index rows) const;
   /// InputError unless `values` has the factor's size (a single_precision_values copy).
   void check_single_values(const cholmod_factor_struct& factor, const std::vector<float>& values) const;
-  /// The supernodes on the paths from the (unpermuted) rows' supernodes to the roots, ascending.
-  std::vector<int> supernodes_above(const std::vector<Eigen::Index>& rows) const;
-  /// The same as a mark per supernode.
+  /// A mark per supernode on the paths from the (unpermuted) rows' supernodes to the roots.
+  /// InputError for rows out of range.
   std::vector<std::uint8_t> supernodes_above_mask(const std::vector<Eigen::Index>& rows) const;
+  /// The same supernodes, ascending.
+  std::vector<int> supernodes_above(const std::vector<Eigen::Index>& rows) const;
 };
 
 }  // namespace cleave
