@@ -259,6 +259,76 @@ TEST(Equilibration, TheLastTwoDesignsAreAnsweredWithoutASolve) {
   EXPECT_LT(difference, 1e-8 * largest);
 }
 
+// A picture first (EquilibrationPass::picture): an edit over fresh cells (no soft modes learned
+// yet) whose first step ends between the target 5e-11 and 1e-6 returns that stress as
+// provisional; finish() then takes the steps the complete pass takes, so the result, the
+// iteration count and the soft modes learned are the complete pass's, bit for bit (the next edit
+// agrees too). A newer edit drops a provisional result and still equals a fresh equilibration.
+TEST(Equilibration, APictureFirstThenFinishIsTheCompletePassBitForBit) {
+  const TissueModel m = test::builtin_model("abdomen");
+  const Vec3 c = m.volume.grid().origin_mm + 0.5 * m.volume.grid().extent_mm();
+  const std::vector<Vec6> start = spotted_design_kPa(m, c);
+  const std::vector<Vec6> edit = spotted_design_kPa(m, c + Vec3(-30.0, 5.0, 0.0));
+  const std::vector<Vec6> next = spotted_design_kPa(m, c + Vec3(25.0, 0.0, -3.0));
+  StressEquilibrator complete(m), picture(m);
+  (void)complete.equilibrate(start);
+  (void)picture.equilibrate(start, EquilibrationPass::picture);  // may be provisional too
+  if (picture.has_provisional()) (void)picture.finish();
+
+  const EquilibrationResult whole = complete.equilibrate(edit);
+  ASSERT_GT(whole.refinement_steps, 1) << "the edit must need more than its first step";
+  const EquilibrationResult provisional = picture.equilibrate(edit, EquilibrationPass::picture);
+  ASSERT_TRUE(provisional.provisional);
+  EXPECT_TRUE(picture.has_provisional());
+  EXPECT_EQ(provisional.refinement_steps, 1);
+  EXPECT_GT(provisional.force_reduction, 5e-11);  // a complete pass would go on
+  EXPECT_LE(provisional.force_reduction, kPictureReduction);
+  EXPECT_EQ(provisional.designed_force_mN, whole.designed_force_mN);
+  double difference = 0, largest = 0;
+  for (std::size_t i = 0; i < whole.stress_kPa.size(); ++i) {
+    difference = std::max(difference, (provisional.stress_kPa[i] - whole.stress_kPa[i]).cwiseAbs().maxCoeff());
+    largest = std::max(largest, whole.stress_kPa[i].cwiseAbs().maxCoeff());
+  }
+  EXPECT_GT(difference, 0.0);
+  EXPECT_LT(difference, 1e-4 * largest);  // what the picture cannot tell apart
+
+  const EquilibrationResult finished = picture.finish();
+  EXPECT_FALSE(finished.provisional);
+  EXPECT_FALSE(picture.has_provisional());
+  EXPECT_TRUE(finished.stress_kPa == whole.stress_kPa);
+  EXPECT_EQ(finished.refinement_steps, whole.refinement_steps);
+  EXPECT_EQ(finished.force_reduction, whole.force_reduction);
+  try {
+    (void)picture.finish();
+    ADD_FAILURE() << "finish() without a provisional result must throw";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "stress equilibration: finish() without a provisional result; expected a call of equilibrate() "
+                           "with EquilibrationPass::picture that returned one");
+  }
+  // The same soft modes and displacement: the next edit agrees bit for bit; the finished design
+  // is remembered as the complete pass remembers it.
+  const EquilibrationResult whole_next = complete.equilibrate(next);
+  EXPECT_TRUE(picture.equilibrate(next).stress_kPa == whole_next.stress_kPa);
+  EXPECT_EQ(picture.equilibrate(edit).refinement_steps, 0);
+
+  // A provisional result dropped by a newer edit: that edit starts from the provisional
+  // displacement and still equals a fresh equilibration.
+  StressEquilibrator dropped(m);
+  (void)dropped.equilibrate(start);
+  ASSERT_TRUE(dropped.equilibrate(edit, EquilibrationPass::picture).provisional);
+  const EquilibrationResult after = dropped.equilibrate(next);
+  EXPECT_FALSE(dropped.has_provisional());
+  EXPECT_LE(after.force_reduction, 1e-10);
+  const std::vector<Vec6> fresh = equilibrate_stress(m, next).stress_kPa;
+  difference = 0;
+  largest = 0;
+  for (std::size_t i = 0; i < fresh.size(); ++i) {
+    difference = std::max(difference, (after.stress_kPa[i] - fresh[i]).cwiseAbs().maxCoeff());
+    largest = std::max(largest, fresh[i].cwiseAbs().maxCoeff());
+  }
+  EXPECT_LT(difference, 1e-8 * largest);
+}
+
 TEST(Equilibration, ABalancedFieldIsLeftAsItIs) {
   const TissueModel m = test::builtin_model("plate", {Vec3i(8, 8, 2), std::nullopt});
   const std::vector<Vec6> zero(static_cast<std::size_t>(m.volume.cell_count()), Vec6::Zero());

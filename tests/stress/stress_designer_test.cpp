@@ -104,5 +104,74 @@ TEST(Designer, AnEditBackToOneOfTheLastTwoDesignsIsAnsweredFromMemory) {
   EXPECT_FALSE(designer.result().remembered);
 }
 
+// The picture first: a stroke dragged over fresh cells of the abdomen, edit by edit, by two
+// designers. One completes each edit (set_design), the other draws from a provisional stress
+// (EquilibrationPass::picture) and completes it afterwards (finish_equilibration): after that
+// every result is the first designer's, bit for bit, the provisional one was within what the
+// picture resolves, and an edit back is answered from memory as for the complete pass.
+TEST(Designer, APictureFirstThenTheFinishedEquilibrationIsTheCompleteEditBitForBit) {
+  const TissueModel m = test::builtin_model("abdomen");
+  StressDesign d = test::abdomen_demo_design(m);
+  d.equilibration = Equilibration::growth;
+  StressDesigner complete(m, d), picture(m, d);
+  const double w = m.volume.grid().extent_mm().x(), l = m.volume.grid().extent_mm().z();
+  const double h = m.volume.grid().cell_size_mm;
+  int provisional_edits = 0;
+  for (int edit = 1; edit <= 4; ++edit) {
+    StressDesign moved = d;
+    moved.strokes[0].points_mm.clear();
+    for (int i = 1; i <= 9; ++i) moved.strokes[0].points_mm.push_back(test::skin_point(m, 0.1 * i * w, 0.2 * l + edit * h));
+    complete.set_design(moved);
+    picture.set_design(moved, EquilibrationPass::picture);
+    const DesignResult& whole = complete.result();
+    if (picture.result().provisional) {
+      ++provisional_edits;
+      EXPECT_GT(picture.result().residual_final, whole.residual_final);  // less balanced, not yet remembered
+      EXPECT_GT(relative_difference(picture.result(), whole), 0.0);
+      EXPECT_LT(relative_difference(picture.result(), whole), 1e-4);
+      picture.finish_equilibration();
+    }
+    EXPECT_FALSE(picture.result().provisional);
+    EXPECT_TRUE(picture.result().stress_kPa == whole.stress_kPa) << "edit " << edit;
+    EXPECT_EQ(picture.result().equilibration_iterations, whole.equilibration_iterations);
+    EXPECT_EQ(picture.result().residual_final, whole.residual_final);
+    picture.finish_equilibration();  // nothing left to do
+    EXPECT_TRUE(picture.result().stress_kPa == whole.stress_kPa);
+  }
+  EXPECT_GE(provisional_edits, 1) << "no edit over fresh cells stopped for the picture";
+  // The last two designs are remembered once finished; a provisional one is not until then.
+  picture.set_design(d, EquilibrationPass::picture);
+  picture.finish_equilibration();
+  complete.set_design(d);
+  EXPECT_TRUE(picture.result().stress_kPa == complete.result().stress_kPa);
+  StressDesign last = d;
+  last.strokes[0].points_mm.clear();
+  for (int i = 1; i <= 9; ++i) last.strokes[0].points_mm.push_back(test::skin_point(m, 0.1 * i * w, 0.2 * l + 4 * h));
+  picture.set_design(last, EquilibrationPass::picture);
+  EXPECT_TRUE(picture.result().remembered);
+  EXPECT_FALSE(picture.result().provisional);
+}
+
+// A provisional edit superseded by the next one: that edit (complete) equals a fresh design.
+TEST(Designer, AnEditAfterAProvisionalOneEqualsAFreshDesign) {
+  const TissueModel m = test::builtin_model("abdomen");
+  StressDesign d = test::abdomen_demo_design(m);
+  d.equilibration = Equilibration::growth;
+  StressDesigner designer(m, d);
+  const double w = m.volume.grid().extent_mm().x(), l = m.volume.grid().extent_mm().z();
+  const double h = m.volume.grid().cell_size_mm;
+  StressDesign moved = d;
+  for (int edit = 1; edit <= 3; ++edit) {
+    moved.strokes[0].points_mm.clear();
+    for (int i = 1; i <= 9; ++i) moved.strokes[0].points_mm.push_back(test::skin_point(m, 0.1 * i * w, 0.2 * l - edit * h));
+    designer.set_design(moved, EquilibrationPass::picture);  // never finished
+  }
+  moved.control_points[0].langer_kPa = 30;
+  designer.set_design(moved);
+  EXPECT_FALSE(designer.result().provisional);
+  EXPECT_LT(relative_difference(designer.result(), design_residual_stress(m, moved)), 1e-8);
+  EXPECT_LE(designer.result().residual_final, 1e-10 * designer.result().residual_designed);
+}
+
 }  // namespace
 }  // namespace cleave

@@ -6,6 +6,7 @@
 #include <Eigen/Eigenvalues>
 #include <cmath>
 #include <fmt/format.h>
+#include <optional>
 
 #include "cleave/core/error.hpp"
 #include "cleave/core/recent_results.hpp"
@@ -104,30 +105,60 @@ struct StressEquilibrator::Impl {
     factorized = true;
   }
 
-  /// Kc u = b from the current u: one step with the factor of Kc + eps I together with the soft
-  /// modes learned from earlier solves, then (when that is not enough) CG preconditioned with
-  /// the factor; keeps the best iterate. Returns the solves with the factor.
-  int solve(const Vector& b) {
-    const double b_norm = b.norm();
-    Vector r;
-    kc.residual(b, u, r);
-    Vector best = u;
-    double best_norm = r.norm();
-    if (best_norm <= kTargetReduction * b_norm) return 0;
-    Vector z = cholesky.solve(r);
+  /// A solve of Kc u = b from the current u, between its first step and the CG after it.
+  struct SolveState {
+    Vector b;
+    double b_norm = 0;
+    Vector r;  ///< b - Kc u as the steps updated it
+    Vector best;
+    double best_norm = 0;
+    int iterations = 0;  ///< solves with the factor so far
+    bool done = false;   ///< u is the solve's result
+    bool first_step_is_best = false;  ///< the first step lowered the residual below the warm start's
+  };
+
+  /// One step with the factor of Kc + eps I together with the soft modes learned from earlier
+  /// solves; done when that (or the warm start) reaches the target.
+  SolveState first_step(Vector b) {
+    SolveState s;
+    s.b = std::move(b);
+    s.b_norm = s.b.norm();
+    kc.residual(s.b, u, s.r);
+    s.best = u;
+    s.best_norm = s.r.norm();
+    if (s.best_norm <= kTargetReduction * s.b_norm) {
+      s.done = true;
+      return s;
+    }
+    const Vector z = cholesky.solve(s.r);
     Vector kz;
     kc.multiply(z, kz);
-    two_level_step(z, kz, r);
-    int iterations = 1;
+    two_level_step(z, kz, s.r);
+    s.iterations = 1;
+    const double r_norm = s.r.norm();
+    if (r_norm < s.best_norm) {
+      s.best_norm = r_norm;
+      s.best = u;
+      s.first_step_is_best = true;
+    }
+    if (r_norm <= kTargetReduction * s.b_norm) {
+      u = s.best;
+      s.done = true;
+    }
+    return s;
+  }
+
+  /// The rest of the solve after first_step: CG preconditioned with the factor; keeps the best
+  /// iterate and learns what CG corrected as a soft mode.
+  void finish_solve(SolveState& s) {
+    if (s.done) return;
+    const Vector& b = s.b;
+    const double b_norm = s.b_norm;
+    Vector& r = s.r;
+    Vector& best = s.best;
+    double& best_norm = s.best_norm;
+    int& iterations = s.iterations;
     double r_norm = r.norm();
-    if (r_norm < best_norm) {
-      best_norm = r_norm;
-      best = u;
-    }
-    if (r_norm <= kTargetReduction * b_norm) {
-      u = best;
-      return iterations;
-    }
     const Vector after_first_step = u;
     // CG from here, preconditioned with the factor's single-precision copy while each of its
     // steps lowers the residual at least kSingleStepReduction-fold (half the bytes to stream: an
@@ -144,7 +175,7 @@ struct StressEquilibrator::Impl {
       }
       return cholesky.solve(residual);
     };
-    z = precondition(r);
+    Vector z = precondition(r);
     Vector p = z;
     double rz = r.dot(z);
     const auto restart_in_double = [&] {
@@ -186,9 +217,54 @@ struct StressEquilibrator::Impl {
       rz = rz_next;
     }
     u = best;
+    s.done = true;
     if (u.allFinite()) learn_soft_mode(u - after_first_step);
-    return iterations;
   }
+
+  /// `result` (stress_kPa holding the design, designed_force_mN set) with sigma = sigma_d + D Bc u
+  /// and what it leaves; ComputeError for a non-finite stress (u is then reset, so that the next
+  /// call does not start from it).
+  EquilibrationResult balanced(EquilibrationResult result, int iterations) {
+    const LinkedVolume& volume = model.volume;
+    result.refinement_steps = iterations;
+    kc.add_stress(u, result.stress_kPa);
+    for (CellId c = 0; c < volume.cell_count(); ++c) {
+      if (!result.stress_kPa[static_cast<std::size_t>(c)].allFinite()) {
+        u.setZero();
+        throw ComputeError(fmt::format("stress equilibration: the stress of cell {} is not finite after {} preconditioned CG "
+                                       "iterations; expected a finite self-balanced field",
+                                       c, iterations));
+      }
+    }
+    Vector remaining = residual_stress_forces(volume, result.stress_kPa);
+    mask(remaining);
+    result.remaining_force_mN = remaining.norm();
+    result.force_reduction = result.remaining_force_mN / result.designed_force_mN;
+    return result;
+  }
+
+  /// The complete pass's result from the finished solve: checked against kRequiredReduction and
+  /// remembered for its design (`unbalanced`: stress_kPa holding the design).
+  EquilibrationResult completed(EquilibrationResult unbalanced, int iterations) {
+    std::vector<Vec6> design = unbalanced.stress_kPa;
+    EquilibrationResult result = balanced(std::move(unbalanced), iterations);
+    if (!(result.force_reduction <= kRequiredReduction)) {
+      u.setZero();  // do not warm-start the next call from a failed solve
+      throw ComputeError(fmt::format("stress equilibration reached only ||T sigma|| / ||T sigma_d|| = {:.3g} after {} "
+                                     "preconditioned CG iterations (required {:.0e})",
+                                     result.force_reduction, result.refinement_steps, kRequiredReduction));
+    }
+    recent.remember(std::move(design), Known{result, u});
+    return result;
+  }
+
+  /// A provisional result waiting for finish(): the solve after its first step and the result
+  /// before it (stress_kPa holding the design).
+  struct Pending {
+    SolveState solve;
+    EquilibrationResult unbalanced;
+  };
+  std::optional<Pending> pending;
 
   /// u += W c and r -= Kc W c for W = [z, soft modes], c minimizing the energy of the error over
   /// span(W) (a Rayleigh-Ritz step; for no soft modes, the first step of CG).
@@ -276,13 +352,14 @@ StressEquilibrator::~StressEquilibrator() = default;
 StressEquilibrator::StressEquilibrator(StressEquilibrator&&) noexcept = default;
 StressEquilibrator& StressEquilibrator::operator=(StressEquilibrator&&) noexcept = default;
 
-EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> designed_kPa) {
+EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> designed_kPa, EquilibrationPass pass) {
   const LinkedVolume& volume = impl_->model.volume;
   if (designed_kPa.size() != static_cast<std::size_t>(volume.cell_count()))
     throw InputError(fmt::format("designed stress holds {} cell tensors; expected one per cell ({})", designed_kPa.size(),
                                  volume.cell_count()));
   for (std::size_t c = 0; c < designed_kPa.size(); ++c)
     if (!designed_kPa[c].allFinite()) throw InputError(fmt::format("designed stress of cell {} is not finite", c));
+  impl_->pending.reset();  // a newer design: the provisional one is dropped (u stays its displacement)
 
   if (const Impl::Known* known = impl_->recent.find(designed_kPa)) {
     impl_->u = known->u;  // the next edit starts from this design's displacement, as after a solve
@@ -302,29 +379,30 @@ EquilibrationResult StressEquilibrator::equilibrate(std::span<const Vec6> design
                                    "(norm {}); expected stresses of finite magnitude in kPa",
                                    load_norm));
   if (!impl_->factorized) impl_->factorize();
-  result.refinement_steps = impl_->solve(-load);
-
-  impl_->kc.add_stress(impl_->u, result.stress_kPa);
-  for (CellId c = 0; c < volume.cell_count(); ++c) {
-    if (!result.stress_kPa[static_cast<std::size_t>(c)].allFinite()) {
-      impl_->u.setZero();  // do not warm-start the next call from a failed solve
-      throw ComputeError(fmt::format("stress equilibration: the stress of cell {} is not finite after {} preconditioned CG "
-                                     "iterations; expected a finite self-balanced field",
-                                     c, result.refinement_steps));
+  Impl::SolveState solve = impl_->first_step(-load);
+  if (pass == EquilibrationPass::picture && !solve.done && solve.first_step_is_best &&
+      solve.best_norm <= kPictureReduction * solve.b_norm) {
+    EquilibrationResult provisional = impl_->balanced(result, solve.iterations);
+    if (provisional.force_reduction <= kPictureReduction) {
+      provisional.provisional = true;
+      impl_->pending = Impl::Pending{std::move(solve), std::move(result)};
+      return provisional;
     }
   }
-  Vector remaining = residual_stress_forces(volume, result.stress_kPa);
-  impl_->mask(remaining);
-  result.remaining_force_mN = remaining.norm();
-  result.force_reduction = result.remaining_force_mN / load_norm;
-  if (!(result.force_reduction <= kRequiredReduction)) {
-    impl_->u.setZero();  // do not warm-start the next call from a failed solve
-    throw ComputeError(fmt::format("stress equilibration reached only ||T sigma|| / ||T sigma_d|| = {:.3g} after {} "
-                                   "preconditioned CG iterations (required {:.0e})",
-                                   result.force_reduction, result.refinement_steps, kRequiredReduction));
-  }
-  impl_->recent.remember({designed_kPa.begin(), designed_kPa.end()}, Impl::Known{result, impl_->u});
-  return result;
+  impl_->finish_solve(solve);
+  return impl_->completed(std::move(result), solve.iterations);
+}
+
+bool StressEquilibrator::has_provisional() const { return impl_->pending.has_value(); }
+
+EquilibrationResult StressEquilibrator::finish() {
+  if (!impl_->pending)
+    throw InputError("stress equilibration: finish() without a provisional result; expected a call of equilibrate() "
+                     "with EquilibrationPass::picture that returned one");
+  Impl::Pending pending = std::move(*impl_->pending);
+  impl_->pending.reset();
+  impl_->finish_solve(pending.solve);
+  return impl_->completed(std::move(pending.unbalanced), pending.solve.iterations);
 }
 
 EquilibrationResult equilibrate_stress(const TissueModel& model, std::span<const Vec6> designed_kPa,

@@ -35,9 +35,18 @@
 // sigma is exactly zero (Hoger's theorem, section 3.1), since T sigma = 0 for a field on cubes
 // implies sum_c V sigma_c = 0.
 //
+// A picture first: a stress accurate to 1e-6 of the designed forces moves the body by 1e-6 of what
+// the design would, far below what the incision preview resolves (its solve stops at 1e-4). With
+// EquilibrationPass::picture an edit whose first step already ends below kPictureReduction returns
+// that stress as provisional (an edit over fresh cells: 1e-10..1e-8 after the first step, then one
+// more step to 5e-11); finish() then takes the same steps the complete pass would have taken from
+// there, bit for bit. The studio draws the picture between the two.
+//
 //   StressEquilibrator eq(model);                 // Kc and its factor, once per topology
 //   EquilibrationResult r = eq.equilibrate(designed_kPa);   // per edit, warm-started
 //   r.stress_kPa  // per cell, Voigt
+//   EquilibrationResult p = eq.equilibrate(designed_kPa, EquilibrationPass::picture);
+//   if (p.provisional) { draw(p.stress_kPa); p = eq.finish(); }
 #include <memory>
 #include <span>
 #include <vector>
@@ -52,7 +61,20 @@ struct EquilibrationResult {
   double designed_force_mN = 0;         ///< ||T sigma_d|| over free vertices (kPa mm^2)
   double remaining_force_mN = 0;        ///< ||T sigma|| over free vertices: what the solve left
   int refinement_steps = 0;             ///< solves with the factor (preconditioned CG iterations); 0 when remembered
+  /// Stopped for the picture (EquilibrationPass::picture): force_reduction is at most
+  /// kPictureReduction but may exceed the complete pass's 1e-10; StressEquilibrator::finish() completes it.
+  bool provisional = false;
 };
+
+/// How far one call equilibrates.
+enum class EquilibrationPass {
+  complete,  ///< to ||T sigma|| <= 5e-11 ||T sigma_d|| (1e-10 required)
+  picture,   ///< may stop after the first solve with the factor when that reaches kPictureReduction
+};
+
+/// The largest ||T sigma|| / ||T sigma_d|| of a provisional result: 1e-6 of the design's forces
+/// moves the body by 1e-6 of what the design would, 100x below the preview's solver tolerance.
+inline constexpr double kPictureReduction = 1e-6;
 
 class StressEquilibrator {
  public:
@@ -69,7 +91,16 @@ class StressEquilibrator {
   /// when ||T sigma|| / ||T sigma_d|| stays above 1e-10 (never returns NaN). Starts from the
   /// displacement of the previous call and the soft modes of the earlier ones (a small edit
   /// needs one or two solves with the factor; one of the last two designs, none).
-  EquilibrationResult equilibrate(std::span<const Vec6> designed_kPa);
+  /// With EquilibrationPass::picture the result may be provisional (see above); a provisional
+  /// result stays pending until finish() or the next equilibrate() call, which drops it (and
+  /// starts from its displacement).
+  EquilibrationResult equilibrate(std::span<const Vec6> designed_kPa, EquilibrationPass pass = EquilibrationPass::complete);
+  /// True while a provisional result waits for finish().
+  bool has_provisional() const;
+  /// Completes the pending provisional result: the steps equilibrate() would have taken after its
+  /// first (the same result, bit for bit, and remembered as it would be). InputError when none is
+  /// pending; ComputeError as equilibrate().
+  EquilibrationResult finish();
 
  private:
   struct Impl;

@@ -80,7 +80,7 @@ StressDesigner::StressDesigner(const TissueModel& model, StressDesign design) : 
   DesignResult next;
   update_directions(design, next);
   update_eigenvalues(design, next);
-  finish(design, next);
+  finish(design, next, EquilibrationPass::complete);
   result_ = std::move(next);
   design_ = std::move(design);
   recent_.remember(key_of(design_), result_);
@@ -116,19 +116,24 @@ void StressDesigner::update_eigenvalues(const StressDesign& design, DesignResult
   out.timings.eigenvalues_s = seconds_since(start);
 }
 
-void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
+void StressDesigner::take_equilibration(EquilibrationResult balanced, DesignResult& out) const {
+  out.stress_kPa = std::move(balanced.stress_kPa);
+  out.equilibration_iterations = balanced.refinement_steps;
+  out.provisional = balanced.provisional;
+  // The equilibration measured T sigma_d and T sigma at the free vertices (the rows the
+  // designer's T keeps): no product with T for the two residuals.
+  out.residual_designed = relative_equilibrium_residual(balanced.designed_force_mN, ops_->norm, out.designed_kPa);
+  out.residual_final = relative_equilibrium_residual(balanced.remaining_force_mN, ops_->norm, out.stress_kPa);
+}
+
+void StressDesigner::finish(const StressDesign& design, DesignResult& out, EquilibrationPass pass) {
   out.designed_kPa = stress_from_frames(out.frames, out.eigenvalues_kPa);
+  out.provisional = false;
   const auto start = std::chrono::steady_clock::now();
   if (design.equilibration == Equilibration::growth) {
     if (!ops_->equilibrator) ops_->equilibrator = std::make_unique<StressEquilibrator>(model_, ops_->held_vertices);
-    EquilibrationResult balanced = ops_->equilibrator->equilibrate(out.designed_kPa);
-    out.stress_kPa = std::move(balanced.stress_kPa);
-    out.equilibration_iterations = balanced.refinement_steps;
+    take_equilibration(ops_->equilibrator->equilibrate(out.designed_kPa, pass), out);
     out.timings.equilibration_s = seconds_since(start);
-    // The equilibration measured T sigma_d and T sigma at the free vertices (the rows the
-    // designer's T keeps): no product with T for the two residuals.
-    out.residual_designed = relative_equilibrium_residual(balanced.designed_force_mN, ops_->norm, out.designed_kPa);
-    out.residual_final = relative_equilibrium_residual(balanced.remaining_force_mN, ops_->norm, out.stress_kPa);
     return;
   }
   out.stress_kPa = out.designed_kPa;
@@ -138,7 +143,28 @@ void StressDesigner::finish(const StressDesign& design, DesignResult& out) {
   out.residual_final = out.residual_designed;
 }
 
-void StressDesigner::set_design(StressDesign design) {
+void StressDesigner::finish_equilibration() {
+  if (!result_.provisional) return;
+  const auto start = std::chrono::steady_clock::now();
+  EquilibrationResult balanced;
+  try {
+    // The equilibrator dropped its pending solve when an edit after this one failed in its own
+    // equilibration: then this design is equilibrated anew.
+    StressEquilibrator& equilibrator = *ops_->equilibrator;
+    balanced = equilibrator.has_provisional() ? equilibrator.finish() : equilibrator.equilibrate(result_.designed_kPa);
+  } catch (const ComputeError&) {
+    design_ = std::move(before_provisional_->design);
+    result_ = std::move(before_provisional_->result);
+    before_provisional_.reset();
+    throw;
+  }
+  take_equilibration(std::move(balanced), result_);
+  result_.timings.equilibration_s += seconds_since(start);
+  before_provisional_.reset();
+  recent_.remember(key_of(design_), result_);
+}
+
+void StressDesigner::set_design(StressDesign design, EquilibrationPass pass) {
   const DesignWeights& a = design.weights;
   const DesignWeights& b = design_.weights;
   if (a.laplacian != b.laplacian || a.constraint != b.constraint || a.equilibrium != b.equilibrium ||
@@ -146,6 +172,7 @@ void StressDesigner::set_design(StressDesign design) {
     throw InputError("design weights, snap tolerance or held vertices changed; expected the same (build a new StressDesigner)");
   // renew: the recalled design becomes the newest again, so the last two are it and the next edit's.
   if (const DesignResult* known = recent_.renew(key_of(design))) {
+    before_provisional_.reset();
     result_ = *known;
     result_.remembered = true;
     result_.timings = {};
@@ -168,7 +195,15 @@ void StressDesigner::set_design(StressDesign design) {
   } else {
     next.eigenvalue_iterations = 0;
   }
-  finish(design, next);
+  finish(design, next, pass);
+  if (next.provisional) {
+    // An edit after a provisional one keeps the first's "before": the last complete design.
+    if (!before_provisional_) before_provisional_ = std::make_unique<Before>(Before{std::move(design_), std::move(result_)});
+    result_ = std::move(next);
+    design_ = std::move(design);
+    return;
+  }
+  before_provisional_.reset();
   result_ = std::move(next);
   design_ = std::move(design);
   recent_.remember(key_of(design_), result_);

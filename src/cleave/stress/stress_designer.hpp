@@ -23,6 +23,16 @@
 // exactly: strokes, control points, solver, equilibration) is answered without redoing a stage
 // (DesignResult::remembered).
 //
+// A picture before the last digits (EquilibrationPass::picture, stress/equilibrate_stress.hpp): an
+// edit may return a provisional stress, equilibrated to 1e-6 of the designed forces instead of
+// 5e-11, which the picture cannot tell apart; finish_equilibration() then completes it to what the
+// complete pass gives, bit for bit. A provisional result is not remembered (see above) until
+// completed; the next edit drops it.
+//
+//   designer.set_design(d, EquilibrationPass::picture);
+//   draw(designer.result());                        // result().provisional may be true
+//   designer.finish_equilibration();                // result() as set_design(d) would give
+//
 // The model must outlive the designer and keep its topology (build a new designer after a cut).
 // Edits that fail validation throw InputError and leave the designer unchanged. Indices out of
 // range are InputErrors too.
@@ -32,6 +42,7 @@
 #include "cleave/core/recent_results.hpp"
 #include "cleave/model/tissue_model.hpp"
 #include "cleave/stress/direction_frames.hpp"
+#include "cleave/stress/equilibrate_stress.hpp"
 #include "cleave/stress/stress_design.hpp"
 
 namespace cleave {
@@ -56,6 +67,9 @@ struct DesignResult {
   /// The design equals one of the last two (undo, redo, a stroke dragged back): this is the
   /// result computed for it then, and no stage was redone (timings 0).
   bool remembered = false;
+  /// stress_kPa is the equilibration's provisional result (EquilibrationPass::picture):
+  /// StressDesigner::finish_equilibration() completes it; residual_final is its own.
+  bool provisional = false;
   DesignTimings timings;
 };
 
@@ -76,7 +90,12 @@ class StressDesigner {
   void move_control_point(std::size_t index, DesignControlPoint point);
   void delete_control_point(std::size_t index);
   /// Replaces the whole design (weights and solver must stay the same: InputError otherwise).
-  void set_design(StressDesign design);
+  /// With EquilibrationPass::picture the result may be provisional (see above).
+  void set_design(StressDesign design, EquilibrationPass pass = EquilibrationPass::complete);
+  /// Completes a provisional result (nothing to do otherwise): the equilibration's remaining
+  /// steps; timings.equilibration_s then holds both parts. When they fail (ComputeError), the
+  /// designer returns to the design before the edit, as a failing set_design leaves it, and rethrows.
+  void finish_equilibration();
 
  private:
   struct Operators;
@@ -92,13 +111,22 @@ class StressDesigner {
   static DesignKey key_of(const StressDesign& design);
   void update_directions(const StressDesign& design, DesignResult& out);
   void update_eigenvalues(const StressDesign& design, DesignResult& out);
-  void finish(const StressDesign& design, DesignResult& out);
+  void finish(const StressDesign& design, DesignResult& out, EquilibrationPass pass);
+  /// The equilibration's figures in `out` (stress, iterations, residuals, provisional).
+  void take_equilibration(EquilibrationResult balanced, DesignResult& out) const;
 
   const TissueModel& model_;
   StressDesign design_;
   std::unique_ptr<Operators> ops_;
   DesignResult result_;
   RecentResults<DesignKey, DesignResult> recent_{2};
+  /// While result_ is provisional: the design and result before that edit (restored when the
+  /// equilibration's completion fails).
+  struct Before {
+    StressDesign design;
+    DesignResult result;
+  };
+  std::unique_ptr<Before> before_provisional_;
 };
 
 /// One-shot design (a StressDesigner without the edits).
