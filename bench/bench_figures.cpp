@@ -33,6 +33,8 @@ std::string_view stage_key(Stage stage) {
     case Stage::update: return "update";
     case Stage::vector_drag: return "vector_drag";
     case Stage::update_drag: return "update_drag";
+    case Stage::update_final: return "update_final";
+    case Stage::update_drag_final: return "update_drag_final";
   }
   return "vector";
 }
@@ -48,6 +50,8 @@ StageFigures& ImplementationFigures::stage(Stage s) {
     case Stage::update: return update;
     case Stage::vector_drag: return vector_drag;
     case Stage::update_drag: return update_drag;
+    case Stage::update_final: return update_final;
+    case Stage::update_drag_final: return update_drag_final;
   }
   return vector;
 }

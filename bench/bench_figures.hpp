@@ -15,8 +15,15 @@
 //                stroke 0 moves among three positions in turn (vector, value and equilibrate are
 //                timed in the same edits): each edit's cells were edited before, but its design
 //                is none of the last two, which every stage would answer from memory (undo)
+//   update       (continued) the picture is drawn from the equilibration's provisional stress
+//                when its first step already reached 1e-6 of the designed forces
+//                (EquilibrationPass::picture), as the studio draws it; the equilibration's
+//                completion after the picture is in update_final, not here
 //   vector_drag  the eigenvector stage of a stroke dragged over fresh cells (one cell per edit)
 //   update_drag  the edit-to-picture update of those edits
+//   update_final, update_drag_final  the same edits until the design is final: the update
+//                plus the equilibration's completion after the picture (equal to the update
+//                for edits whose first step completed it)
 #include <cstdint>
 #include <optional>
 #include <string>
@@ -41,10 +48,24 @@ std::string_view implementation_key(Implementation implementation);
 /// Inverse of implementation_key; throws InputError naming `option` and listing the keys.
 Implementation implementation_from_key(std::string_view key, std::string_view option);
 
-enum class Stage { vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag };
-inline constexpr Stage kAllStages[] = {Stage::vector, Stage::value,  Stage::value_point, Stage::equilibrate, Stage::preview,
-                                       Stage::step,   Stage::update, Stage::vector_drag, Stage::update_drag};
-/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update", "vector_drag", "update_drag".
+enum class Stage {
+  vector,
+  value,
+  value_point,
+  equilibrate,
+  preview,
+  step,
+  update,
+  vector_drag,
+  update_drag,
+  update_final,
+  update_drag_final
+};
+inline constexpr Stage kAllStages[] = {Stage::vector,      Stage::value,       Stage::value_point,  Stage::equilibrate,
+                                       Stage::preview,     Stage::step,        Stage::update,       Stage::vector_drag,
+                                       Stage::update_drag, Stage::update_final, Stage::update_drag_final};
+/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update", "vector_drag", "update_drag",
+/// "update_final", "update_drag_final".
 std::string_view stage_key(Stage stage);
 
 struct StageFigures {
@@ -58,7 +79,8 @@ struct StageFigures {
 struct ImplementationFigures {
   Implementation implementation = Implementation::cleave;
   std::string solver;  ///< the solver's own name as it reports it
-  StageFigures vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag;
+  StageFigures vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag, update_final,
+      update_drag_final;
   double peak_mb = 0;  ///< peak resident memory while this implementation ran (MB = 1e6 bytes)
 
   StageFigures& stage(Stage s);

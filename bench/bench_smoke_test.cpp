@@ -92,6 +92,11 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
     ASSERT_TRUE(m["ms_step"].is_number());
     EXPECT_GT(m["iterations"]["step"].get<int>(), 0);
     EXPECT_GT(m["iterations"]["equilibrate"].get<int>(), 0);  // the stroke edits unbalance the design
+    // The picture comes first; each edit's final design is the picture's edit plus its completion.
+    ASSERT_TRUE(m["ms_update_final"].is_number());
+    ASSERT_TRUE(m["ms_update_drag_final"].is_number());
+    EXPECT_GE(m["ms_update_final"].get<double>(), m["ms_update"].get<double>());
+    EXPECT_GE(m["ms_update_drag_final"].get<double>(), m["ms_update_drag"].get<double>());
     // The CLI restarted itself with the heap in huge pages (glibc 2.36 on Debian 12; not under ASan).
     EXPECT_EQ(m["machine"]["malloc_huge_pages"].get<bool>(), !kAddressSanitizer);
     for (const char* peer : {"paper", "eigen_cg", "cholmod"}) {
@@ -124,7 +129,7 @@ TEST(BenchSmoke, AboveDesignMaxCellsTheDesignIsSkippedAndTheSolverStagesRunOnThe
   ASSERT_EQ(lines.size(), 1u);
   const nlohmann::json& m = lines.front();
   EXPECT_EQ(m["residual_stress"], "prescribed");
-  for (const char* stage : {"vector", "value", "value_point", "equilibrate", "update"}) {
+  for (const char* stage : {"vector", "value", "value_point", "equilibrate", "update", "update_final", "update_drag_final"}) {
     SCOPED_TRACE(stage);
     EXPECT_TRUE(m["ms_" + std::string(stage)].is_null());
     ASSERT_TRUE(m["skipped"].contains(stage));

@@ -18,7 +18,10 @@
 //           update = the whole stroke edit as the studio does it: the designer's update, the
 //           incision preview solve with the new stress on the incised body (stiffness assembled
 //           once, cut topology unchanged by a stroke edit) and the deformed render surface.
-//           vector_drag / update_drag: the same two for the drag's edits.
+//           The picture is drawn from the equilibration's provisional stress when it has one
+//           (EquilibrationPass::picture, as the studio draws it); the completion after the
+//           picture is timed apart: update_final = update + completion.
+//           vector_drag / update_drag / update_drag_final: the same for the drag's edits.
 //   paper   one thread; vector = PaperDirections (plain CG, Langer and normal fields, warm
 //           started), value / value_point = StressDesigner with EigenvalueSolver::paper_cg (the
 //           paper's CG on A^T A, warm-started from the previous eigenvalues); equilibrate is not
@@ -34,7 +37,7 @@
 namespace cleave::bench {
 
 struct DesignOutcome {
-  StageFigures vector, value, value_point, equilibrate, update, vector_drag, update_drag;
+  StageFigures vector, value, value_point, equilibrate, update, vector_drag, update_drag, update_final, update_drag_final;
   Eigen::VectorXd line_tensors;  ///< frame_line_tensors of the final frames
   Eigen::VectorXd eigenvalues_kPa;  ///< 3 per cell (Langer, cross, normal)
 };

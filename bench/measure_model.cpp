@@ -46,11 +46,13 @@ ImplementationResults run_implementation(const TissueModel& model, const BenchSc
     r.figures.update = design.update;
     r.figures.vector_drag = design.vector_drag;
     r.figures.update_drag = design.update_drag;
+    r.figures.update_final = design.update_final;
+    r.figures.update_drag_final = design.update_drag_final;
     r.line_tensors = std::move(design.line_tensors);
     r.eigenvalues_kPa = std::move(design.eigenvalues_kPa);
   } else {
     for (StageFigures* s : {&r.figures.vector, &r.figures.value, &r.figures.value_point, &r.figures.equilibrate, &r.figures.update,
-                            &r.figures.vector_drag, &r.figures.update_drag})
+                            &r.figures.vector_drag, &r.figures.update_drag, &r.figures.update_final, &r.figures.update_drag_final})
       s->skipped = design_skipped;
   }
   report(progress, who + ": incision preview", done + 0.4 * share);

@@ -78,37 +78,38 @@ StudioCompute::StudioCompute(const StudioSession& session, std::function<void(st
   server_token_ = fmt::format("{:08x}{:08x}", entropy(), entropy());
   worker_ = std::make_unique<FieldWorker>(
       [this](FieldWorker::Result r) {
-        // How much work the edits caused: an edit that arrives while another's work runs replaces
-        // the queued one, which then never starts (skipped); the page and its tests can see it.
-        if (r.message.value("type", "") != "result") {
-          send_(wire_encoded(r.message));
-          return;
-        }
-        r.message["computations"] = {{"submitted", worker_->jobs_submitted()},
-                                     {"started", worker_->jobs_started()},
-                                     {"skipped", worker_->jobs_skipped()},
-                                     {"published", ++results_published_}};
-        // The connected clients hold the triangles of the surface they were last sent (every
-        // result reaches every client; one that connects later gets latest_result_ in full).
-        nlohmann::json& surface = r.message["surface"];
-        nlohmann::json triangles;
-        if (surface.is_object()) {
-          const std::string id = surface.value("id", "");
-          if (id == broadcast_surface_id_ && surface.contains("triangles")) {
-            triangles = std::move(surface["triangles"]);
-            surface.erase("triangles");
-          }
-          broadcast_surface_id_ = id;
-        }
-        std::string text = wire_encoded(r.message);
-        if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
-        {
-          std::lock_guard lock(latest_mutex_);
-          latest_result_ = std::move(r.message);
-        }
-        send_(std::move(text));
+        if (r.message.value("type", "") == "result") publish_result(std::move(r.message));
+        else send_(wire_encoded(r.message));
       },
       [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump()); }, jobs);
+}
+
+void StudioCompute::publish_result(nlohmann::json message) {
+  // How much work the edits caused: an edit that arrives while another's work runs replaces
+  // the queued one, which then never starts (skipped); the page and its tests can see it.
+  message["computations"] = {{"submitted", worker_->jobs_submitted()},
+                             {"started", worker_->jobs_started()},
+                             {"skipped", worker_->jobs_skipped()},
+                             {"published", ++results_published_}};
+  // The connected clients hold the triangles of the surface they were last sent (every
+  // result reaches every client; one that connects later gets latest_result_ in full).
+  nlohmann::json& surface = message["surface"];
+  nlohmann::json triangles;
+  if (surface.is_object()) {
+    const std::string id = surface.value("id", "");
+    if (id == broadcast_surface_id_ && surface.contains("triangles")) {
+      triangles = std::move(surface["triangles"]);
+      surface.erase("triangles");
+    }
+    broadcast_surface_id_ = id;
+  }
+  std::string text = wire_encoded(message);
+  if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
+  {
+    std::lock_guard lock(latest_mutex_);
+    latest_result_ = std::move(message);
+  }
+  send_(std::move(text));
 }
 
 StudioCompute::~StudioCompute() { worker_.reset(); }
@@ -159,13 +160,17 @@ const DesignResult* StudioCompute::design_fields(const DesignState& design, nloh
     // equilibrium term, exactly equilibrated at the free vertices; the residual display shows
     // what is left).
     try {
+      // The picture may be drawn from the equilibration's provisional stress (1e-6 of the
+      // designed forces: what the picture cannot tell apart); complete_design() finishes it
+      // after the picture is sent.
       if (!designer_) designer_ = std::make_unique<StressDesigner>(model, stress_design);
-      else designer_->set_design(stress_design);
+      else designer_->set_design(stress_design, EquilibrationPass::picture);
       const DesignResult& r = designer_->result();
       timings["directions"] = 1000.0 * r.timings.directions_s;
       timings["eigenvalues"] = 1000.0 * r.timings.eigenvalues_s;
       if (stress_design.equilibration != Equilibration::none) timings["equilibration"] = 1000.0 * r.timings.equilibration_s;
       message["equilibrium_residual"] = {{"designed", r.residual_designed}, {"final", r.residual_final}};
+      if (r.provisional) message["equilibrium_residual"]["provisional"] = true;
       stress_kPa_ = r.stress_kPa;
       return &r;
     } catch (const InputError& err) {
@@ -367,6 +372,15 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
   displacement_mm_.clear();
   if (has_stress && !requests.empty()) {
     if (user_cuts_changed && !design.cuts.empty()) {
+      // The opening takes seconds: it starts from the final design, not the provisional one.
+      if (designer_ && designer_->result().provisional) {
+        t = Clock::now();
+        designer_->finish_equilibration();
+        const DesignResult& r = designer_->result();
+        stress_kPa_ = r.stress_kPa;
+        message["equilibrium_residual"] = {{"designed", r.residual_designed}, {"final", r.residual_final}};
+        timings["equilibration"] = 1000.0 * r.timings.equilibration_s;
+      }
       stream_opening(design, ctx.generation, ctx, timings);
       if (ctx.superseded()) return nullptr;
     }
@@ -404,21 +418,7 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     f["langer_kPa"] = packed_floats(langer);
     f["cross_kPa"] = packed_floats(cross);
   }
-  if (has_stress) {
-    if (divergence_.size() == 0) {
-      SparseMatrix divergence = stress_divergence_matrix(model.volume);
-      divergence_.swap(divergence);
-    }
-    // An edit back to a recent design gives the same stress on the same surface: the same values.
-    if (const std::vector<float>* known = surface_residuals_.find(stress_kPa_)) {
-      f["residual_kPa"] = packed_floats(*known);
-    } else {
-      std::vector<float> residual =
-          residual_per_surface_vertex(model.volume, divergence_, stress_kPa_, surface, design_settings_.held_vertices);
-      f["residual_kPa"] = packed_floats(residual);
-      surface_residuals_.remember(stress_kPa_, std::move(residual));
-    }
-  }
+  if (has_stress) f["residual_kPa"] = packed_floats(surface_residual());
   if (!displacement_mm_.empty()) f["displacement_mm"] = packed_floats(moved);
   // Cut faces coloured by depth (0 skin .. 1 inner layer) and by released traction (paper fig. 5).
   if (cut_face_layout_.any) {
@@ -506,6 +506,59 @@ nlohmann::json StudioCompute::compute(const DesignState& design, std::uint64_t s
     ExportSnapshot snapshot{preview_model_, displacement_mm_, stress_kPa_, make_surface_mesh(surface, x)};
     std::lock_guard lock(latest_mutex_);
     latest_export_ = std::move(snapshot);
+  }
+  if (message["type"] == "result" && designer_ && designer_->result().provisional) {
+    if (ctx.superseded()) return nullptr;  // as the worker drops a superseded result
+    publish_result(std::move(message));   // the picture now; the design's last digits follow
+    return complete_design(seq, ctx);
+  }
+  return message;
+}
+
+const std::vector<float>& StudioCompute::surface_residual() {
+  if (divergence_.size() == 0) {
+    SparseMatrix divergence = stress_divergence_matrix(session_.model().volume);
+    divergence_.swap(divergence);
+  }
+  // An edit back to a recent design gives the same stress on the same surface: the same values.
+  if (const std::vector<float>* known = surface_residuals_.find(stress_kPa_)) return *known;
+  surface_residuals_.remember(stress_kPa_, residual_per_surface_vertex(session_.model().volume, divergence_, stress_kPa_,
+                                                                       *preview_surface_, design_settings_.held_vertices));
+  return *surface_residuals_.find(stress_kPa_);
+}
+
+nlohmann::json StudioCompute::complete_design(std::uint64_t seq, const FieldWorker::Context& ctx) {
+  report(ctx.progress, "completing the equilibration", 0.95);
+  if (ctx.superseded()) return nullptr;  // the next edit drops the provisional stress
+  const auto t = Clock::now();
+  try {
+    designer_->finish_equilibration();
+  } catch (const ComputeError& e) {
+    designer_.reset();
+    return {{"type", "error"},
+            {"stage", "equilibration"},
+            {"message", fmt::format("computation failed: {}; the picture shows the provisional stress", e.what())}};
+  }
+  const DesignResult& r = designer_->result();
+  stress_kPa_ = r.stress_kPa;
+  nlohmann::json fields = {{"residual_kPa", packed_floats(surface_residual())}};
+  if (cut_face_layout_.any) fields["traction_kPa"] = packed_floats(cut_face_traction_kPa(cut_face_layout_, *preview_surface_, stress_kPa_));
+  nlohmann::json message = {{"type", "design_final"},
+                            {"generation", ctx.generation},
+                            {"seq", seq},
+                            {"equilibrium_residual", {{"designed", r.residual_designed}, {"final", r.residual_final}}},
+                            {"equilibration_iterations", r.equilibration_iterations},
+                            {"fields", std::move(fields)},
+                            {"timings_ms", {{"equilibration_completion", ms_since(t)}}}};
+  message = checked_outgoing(std::move(message));
+  if (message["type"] != "design_final") return message;
+  // What a client that connects later gets, and what the exports write: the final design.
+  std::lock_guard lock(latest_mutex_);
+  latest_export_.stress_kPa = stress_kPa_;
+  if (latest_result_.value("generation", std::uint64_t{0}) == ctx.generation) {
+    for (const auto& [key, value] : message["fields"].items()) latest_result_["fields"][key] = value;
+    latest_result_["equilibrium_residual"] = message["equilibrium_residual"];
+    latest_result_["timings_ms"]["equilibration_completion"] = message["timings_ms"]["equilibration_completion"];
   }
   return message;
 }

@@ -54,6 +54,15 @@ class StudioCompute {
 
  private:
   nlohmann::json compute(const DesignState& design, std::uint64_t seq, const FieldWorker::Context& ctx);
+  /// Sends a "result" to every client and keeps it for those that connect later (worker thread).
+  void publish_result(nlohmann::json message);
+  /// After a picture drawn from a provisional stress: the equilibration's remaining steps, as a
+  /// "design_final" message (the stress's residual display and cut-face tractions, the final
+  /// residual); null when superseded (the next edit drops the provisional stress).
+  nlohmann::json complete_design(std::uint64_t seq, const FieldWorker::Context& ctx);
+  /// The equilibrium residual display of stress_kPa_ on preview_surface_ (remembered for the
+  /// last two stresses).
+  const std::vector<float>& surface_residual();
   void prepare(const FieldWorker::Context& ctx);
   /// Stage 1: the design fields. Sets `fields` (null when nothing is designed) and stress_kPa_;
   /// eigenvalue or equilibration failures go into `message` and leave the directions shown.

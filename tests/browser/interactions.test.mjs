@@ -14,8 +14,8 @@ let browser;
 before(async () => { browser = await launchBrowser(tools.chromium); });
 after(async () => { await browser.close(); });
 
-async function withStudio(name, fn) {
-  const server = await startServer({ bin: tools.bin, session: freshSessionDir(name), res: RES });
+async function withStudio(name, fn, model = 'abdomen') {
+  const server = await startServer({ bin: tools.bin, session: freshSessionDir(name), res: RES, model });
   const page = await openStudio(browser.context, server.url);
   try {
     await fn({ page, server });
@@ -318,4 +318,39 @@ test('a burst of edits supersedes stale work: progress shows, stale queued work 
     console.log(`# stroke to picture on the abdomen ${RES}: ${JSON.stringify(rs.timings_ms)}`);
     assert.ok(Number.isFinite(rs.timings_ms.total));
   });
+});
+
+// The free abdomen (equilibrium at every vertex): a stroke dragged over fresh cells needs a second
+// equilibration step, so the picture is drawn from the provisional stress and a "design_final"
+// message completes it. The page applies it to the shown result: the residual display and note
+// are the final design's.
+test('a picture from a provisional stress is completed by the final design', async () => {
+  const folder = freshSessionDir('free-case');
+  const casePath = `${folder}/free-abdomen.json`;
+  fs.writeFileSync(casePath, JSON.stringify({ cleave_case: 1, model: { source: 'abdomen' },
+    design: { equilibrium_support: 'none', weights: { equilibrium: 0 } } }));
+  await withStudio('15-provisional-then-final', async ({ page }) => {
+    const { result } = await strokeAndPoint(page);
+    assert.ok(result.incisions.length > 0, 'the preview opened');
+    const strokeId = await page.evaluate(() => window.studio.app.state.design.strokes[0].id);
+    const h = result.cell_size_mm;
+    for (let drag = 0; drag < 6; drag++) {
+      await page.evaluate(([id, dz]) => window.studio.send('move_stroke', { id, offset_mm: [0, 0, dz] }), [strokeId, h]);
+      await waitForResult(page, await seqOf(page));
+      try {
+        await page.waitForFunction(() => window.studio.app.finalCount > 0, null, { timeout: 3000 });
+        break;
+      } catch { /* this drag's first step completed the equilibration: drag further */ }
+    }
+    const app = await page.evaluate(() => {
+      const a = window.studio.app;
+      return { finalCount: a.finalCount, residual: a.result.equilibrium_residual, seq: a.result.seq,
+        notes: document.getElementById('notes').textContent, timings: document.getElementById('timing-table').textContent };
+    });
+    assert.ok(app.finalCount > 0, 'one of six drags over fresh cells of the free body was provisional');
+    assert.equal(app.residual.provisional, undefined, 'the shown result is the final design');
+    assert.ok(app.residual.final < 1e-8, `final residual ${app.residual.final}`);
+    assert.ok(!app.notes.includes('provisional'), app.notes);
+    assert.match(app.timings, /equilibration completed \(after the picture\)/);
+  }, casePath);
 });

@@ -244,6 +244,79 @@ TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) 
   EXPECT_NEAR(late["wounds"][0]["width_mm"].get<double>(), early["wounds"][0]["width_mm"].get<double>(), 1e-6);
 }
 
+// A stroke dragged over fresh cells: the picture is drawn from the equilibration's provisional
+// stress, then a "design_final" message of the same edit brings the final design's residual
+// display and residual; a client that connects afterwards gets the final one.
+TEST(StudioCompute, APictureFromAProvisionalStressIsFollowedByTheFinalDesign) {
+  // The free body (equilibrium at every vertex, as the bench's scenario): its thin shell's soft
+  // modes make an edit over fresh cells take a second step (with the rim held, one suffices).
+  json free_body = bare_model_case(kCoarseAbdomen);
+  free_body["design"]["equilibrium_support"] = "none";
+  StudioSession session(fresh_folder("provisional"), free_body);
+  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
+  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
+  for (const json& p : demo["control_points"])
+    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
+                        {"cross_kPa", p["cross_kPa"]}});
+  std::mutex m;
+  std::vector<json> sent;
+  StudioCompute compute(session, [&](std::string text) {
+    std::lock_guard lock(m);
+    sent.push_back(wire_decoded(text));
+  });
+  const auto recompute = [&] {
+    compute.design_changed(session.design(), session.seq());
+    compute.wait_idle();
+  };
+  recompute();
+  const double h = session.model().volume.grid().cell_size_mm;
+  const std::uint64_t first_stroke = session.design().strokes.front().id;
+  for (int drag = 0; drag < 4; ++drag) {
+    session.apply_edit({{"cmd", "move_stroke"}, {"id", first_stroke}, {"offset_mm", {0.0, 0.0, h}}});
+    recompute();
+  }
+  std::lock_guard lock(m);
+  int provisional = 0;
+  json last_final;
+  for (std::size_t i = 0; i < sent.size(); ++i) {
+    const json& r = sent[i];
+    ASSERT_NE(r["type"], "error") << r.dump().substr(0, 300);
+    EXPECT_EQ(first_non_finite(r), std::nullopt);
+    if (r["type"] == "design_final") {
+      ADD_FAILURE() << "a design_final without the provisional result before it";
+      continue;
+    }
+    if (r["type"] != "result" || !r["equilibrium_residual"].contains("provisional")) continue;
+    ++provisional;
+    while (i + 1 < sent.size() && sent[i + 1]["type"] == "progress") ++i;  // a heartbeat may come between
+    ASSERT_LT(i + 1, sent.size());
+    const json& f = sent[++i];
+    ASSERT_EQ(f["type"], "design_final");
+    EXPECT_EQ(f["seq"], r["seq"]);
+    EXPECT_EQ(f["generation"], r["generation"]);
+    EXPECT_LT(f["equilibrium_residual"]["final"].get<double>(), r["equilibrium_residual"]["final"].get<double>());
+    EXPECT_LT(f["equilibrium_residual"]["final"].get<double>(), 1e-8);
+    EXPECT_EQ(f["equilibrium_residual"]["designed"], r["equilibrium_residual"]["designed"]);
+    EXPECT_GE(f["equilibration_iterations"].get<int>(), 2);
+    EXPECT_TRUE(f["timings_ms"].contains("equilibration_completion"));
+    const std::vector<float> before = unpacked_floats(r["fields"]["residual_kPa"]);
+    const std::vector<float> after = unpacked_floats(f["fields"]["residual_kPa"]);
+    ASSERT_EQ(after.size(), before.size()) << "one value per vertex of the same surface";
+    EXPECT_NE(after, before);
+    last_final = f;
+  }
+  ASSERT_GE(provisional, 1) << "no drag over fresh cells stopped for the picture";
+  const auto last = std::find_if(sent.rbegin(), sent.rend(), [](const json& r) { return r["type"] != "progress"; });
+  const json& latest = *last;
+  ASSERT_EQ(latest["type"], "design_final") << "the last drag's equilibration completes after its picture";
+  const std::vector<std::string> welcome = compute.welcome_messages();
+  ASSERT_EQ(welcome.size(), 1u);
+  const json joined = wire_decoded(welcome[0]);
+  EXPECT_EQ(joined["seq"], latest["seq"]);
+  EXPECT_EQ(joined["equilibrium_residual"], latest["equilibrium_residual"]) << "a new client gets the final design";
+  EXPECT_EQ(unpacked_floats(joined["fields"]["residual_kPa"]), unpacked_floats(latest["fields"]["residual_kPa"]));
+}
+
 TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBothAgree) {
   StudioSession session(fresh_folder("handoff"), bare_model_case(kCoarseAbdomen));
   const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];

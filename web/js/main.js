@@ -10,6 +10,7 @@ const app = {
   state: null,          // last "state" message (design, seq, can_undo, can_redo)
   result: null,         // last "result" message (surface, fields, timings)
   resultCount: 0,
+  finalCount: 0,        // "design_final" messages applied (an equilibration completed after its picture)
   tool: 'orbit',
   selected: { kind: null, id: null },
   wound: null,
@@ -79,6 +80,19 @@ function onMessage(m) {
       $('wound-width').textContent = '–';
     }
     $('model-info').textContent = `${app.state ? app.state.model.source : ''} · ${m.cells} cells · ${m.cell_size_mm.toFixed(2)} mm`;
+  } else if (m.type === 'design_final') {
+    // The picture came from the equilibration's provisional stress (1e-6 of the designed forces);
+    // this completes that edit's design: its residual display, cut-face tractions and residual.
+    const r = app.result;
+    if (!r || r.seq !== m.seq || r.generation !== m.generation) return;
+    app.finalCount++;
+    Object.assign(r.fields, m.fields);
+    r.equilibrium_residual = m.equilibrium_residual;
+    Object.assign(r.timings_ms, m.timings_ms);
+    viewer.setDisplay(viewer.display);
+    renderTimings(r.timings_ms);
+    showNotes(r);
+    $('progress').hidden = true;
   } else if (m.type === 'frame') {
     // The wound opening, streamed step by step before the final result.
     app.frames++;
@@ -103,7 +117,7 @@ function onMessage(m) {
 }
 
 const STAGES = { directions: 'directions', eigenvalues: 'eigenvalues', equilibration: 'equilibration', cuts: 'cut model', opening: 'wound opening (frames)',
-  frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', streamlines: 'streamlines', measurements: 'incision and wound measurements', total: 'computed (server)' };
+  equilibration_completion: 'equilibration completed (after the picture)', frame: 'one simulation frame', incisions: 'incisions open (statics)', surface: 'surface and fields', streamlines: 'streamlines', measurements: 'incision and wound measurements', total: 'computed (server)' };
 /// Rows the page measures itself, after the server's stages.
 const PAGE_ROWS = { decode: 'received and decoded (page)', picture: 'edit to picture (page)' };
 const pageTimes = {};
@@ -157,7 +171,10 @@ function showNotes(m) {
   const notes = [];
   if (m.eigenvalue_note) notes.push(['note', m.eigenvalue_note]);
   for (const key of ['design_error', 'cut_error']) if (m[key]) notes.push(['error', m[key]]);
-  if (m.equilibrium_residual) notes.push(['note', `equilibrium residual ||T σ|| / (||T|| ||σ||) = ${m.equilibrium_residual.final.toExponential(2)}`]);
+  if (m.equilibrium_residual) {
+    const provisional = m.equilibrium_residual.provisional ? ' (provisional: the equilibration completes after the picture)' : '';
+    notes.push(['note', `equilibrium residual ||T σ|| / (||T|| ||σ||) = ${m.equilibrium_residual.final.toExponential(2)}${provisional}`]);
+  }
   if (m.statics_solver === 'multigrid' && !m.statics_note) notes.push(['note', 'incisions solved by the multigrid while the direct factor of this cut body is prepared (later edits: faster)']);
   if (m.statics_note) notes.push(['error', m.statics_note]);
   $('notes').replaceChildren(...notes.map(([cls, text]) => { const d = document.createElement('div'); d.className = cls; d.textContent = text; return d; }));
