@@ -222,6 +222,40 @@ TEST(SolverAgreement, CholmodLeavesOutOnlyALoadsNegligibleEntriesInItsFirstFloat
   }
 }
 
+// A load beyond float's range (|b| up to 1e40 or 1e100, > 3.4e38) cannot go through the float factor: the
+// solver checks before the first float substitution, counts none, and solves with the double
+// factor, bit for bit as without the float copy. A load just inside float's range still takes
+// the float path.
+TEST(SolverAgreement, CholmodSolvesALoadBeyondFloatsRangeWithTheDoubleFactor) {
+  TissueModel model = test::make_box({12, 10, 8}, 2.5);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  SolveSettings settings;
+  settings.relative_tolerance = 1e-3;
+  settings.single_precision_factor = true;
+  auto single = make_linear_solver(SolverKind::cholmod, settings);
+  single->setup(s.a, model.volume);
+  settings.single_precision_factor = false;
+  auto plain = make_linear_solver(SolverKind::cholmod, settings);
+  plain->setup(s.a, model.volume);
+  for (const double scale : {1e100, 1e40}) {
+    const Vector b = scale * s.b / s.b.cwiseAbs().maxCoeff();
+    Vector x = Vector::Zero(b.size()), exact = Vector::Zero(b.size());
+    const SolveReport report = single->solve(b, x);
+    plain->solve(b, exact);
+    EXPECT_EQ(report.iterations, 1) << scale << ": no float substitution, one double one";
+    EXPECT_TRUE(report.converged) << scale;
+    EXPECT_TRUE(x.allFinite()) << scale;
+    EXPECT_EQ(x, exact) << scale;
+  }
+  const Vector inside = 1e30 * s.b / s.b.cwiseAbs().maxCoeff();
+  Vector x = Vector::Zero(inside.size()), exact = Vector::Zero(inside.size());
+  const SolveReport report = single->solve(inside, x);
+  plain->solve(inside, exact);
+  EXPECT_TRUE(report.converged);
+  EXPECT_NE(x, exact) << "within float's range: the float factor's solution, not the double one's";
+  EXPECT_LT((x - exact).norm(), 1e-3 * exact.norm());
+}
+
 TEST(SolverFactory, NamesRoundTripAndUnknownNamesAreListed) {
   for (const SolverKind kind : {SolverKind::multigrid_cg, SolverKind::eigen_cg, SolverKind::cholmod}) {
     EXPECT_EQ(solver_kind_from_name(solver_kind_name(kind)), kind);
