@@ -57,6 +57,13 @@ StressDesign design_settings(const CaseFile& case_file) {
   return parse_design_settings_json(*section, case_file.at("design"));
 }
 
+bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b) {
+  if (a.size() != b.size()) return false;
+  for (std::size_t i = 0; i < a.size(); ++i)
+    if (a[i].placement != b[i].placement || a[i].points_mm != b[i].points_mm) return false;
+  return true;
+}
+
 /// Triangle indices of `surface` without the hidden plugs of the round incisions.
 std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const CutPlan& plan) {
   std::vector<std::uint8_t> hidden(surface.quad_of_face.size() / 6, 0);
@@ -174,8 +181,12 @@ const DesignResult* StudioCompute::design_fields(const DesignState& design, nloh
       stress_kPa_ = r.stress_kPa;
       return &r;
     } catch (const InputError& err) {
-      message["design_error"] = err.what();  // e.g. a control point off the surface: directions still shown
-      designer_.reset();
+      // An edit that fails validation (a stroke or point dragged off the surface) leaves the
+      // designer as it was (StressDesigner's contract): it is kept, with its factors, for the next
+      // edit. With the strokes unchanged the error is in the control points: the last valid
+      // design is shown; otherwise the new strokes' directions are, if they are valid.
+      message["design_error"] = err.what();
+      if (designer_ && same_strokes(stress_design.strokes, designer_->design().strokes)) return last_valid_design(message);
     } catch (const ComputeError& err) {
       message["design_error"] = err.what();
       designer_.reset();
@@ -187,23 +198,34 @@ const DesignResult* StudioCompute::design_fields(const DesignState& design, nloh
   // no eigenvalues (paper section 6.3).
   const auto t = Clock::now();
   try {
+    // The strokes are checked before the interpolator is built (a factorization: 1 s at 45k cells).
+    const double tolerance_mm = stress_design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
+    const std::vector<LineTarget> targets = stroke_line_targets(model, stress_design.strokes, tolerance_mm);
     if (!langer_only_) {
       langer_only_ = std::make_unique<LineFieldInterpolator>(model.volume, stress_design.weights);
       LineFieldInterpolator normal_interp(model.volume, stress_design.weights);
       normal_axes_ = normal_axes(normal_interp.interpolate(surface_normal_targets(model)));
     }
-    const double tolerance_mm = stress_design.snap_tolerance_cells * model.volume.grid().cell_size_mm;
-    const std::vector<LineTarget> targets = stroke_line_targets(model, stress_design.strokes, tolerance_mm);
     directions_only_ = DesignResult{};
     directions_only_.frames = direction_frames(langer_only_->interpolate(targets), normal_axes_);
   } catch (const InputError& err) {
     message["design_error"] = err.what();
+    if (designer_) return last_valid_design(message);  // the strokes are invalid: nothing newer to show
     return nullptr;
   }
   timings["directions"] = ms_since(t);
   if (!message.contains("design_error") && stress_design.control_points.empty())
     message["eigenvalue_note"] = "directions only: place a control point (Magnitude tool) to set the eigenvalues";
   return &directions_only_;
+}
+
+const DesignResult* StudioCompute::last_valid_design(nlohmann::json& message) {
+  const DesignResult& r = designer_->result();
+  message["design_error"] = message["design_error"].get<std::string>() + "; the last valid design is shown";
+  message["equilibrium_residual"] = {{"designed", r.residual_designed}, {"final", r.residual_final}};
+  if (r.provisional) message["equilibrium_residual"]["provisional"] = true;
+  stress_kPa_ = r.stress_kPa;
+  return &r;
 }
 
 bool StudioCompute::cut_model(const CutRequests& requests, const std::string& key, nlohmann::json& message) {

@@ -67,6 +67,9 @@ class StudioCompute {
   /// Stage 1: the design fields. Sets `fields` (null when nothing is designed) and stress_kPa_;
   /// eigenvalue or equilibration failures go into `message` and leave the directions shown.
   const DesignResult* design_fields(const DesignState& design, nlohmann::json& message, nlohmann::json& timings);
+  /// After an edit that failed validation (message["design_error"] says why): the designer's
+  /// last valid design, which the designer kept, in stress_kPa_ and the message.
+  const DesignResult* last_valid_design(nlohmann::json& message);
   /// Stage 2: the model cut by `requests`; reuses the previous cut model when `key` is unchanged.
   /// Returns true when the cut model was rebuilt.
   bool cut_model(const CutRequests& requests, const std::string& key, nlohmann::json& message);

@@ -317,6 +317,54 @@ TEST(StudioCompute, APictureFromAProvisionalStressIsFollowedByTheFinalDesign) {
   EXPECT_EQ(unpacked_floats(joined["fields"]["residual_kPa"]), unpacked_floats(latest["fields"]["residual_kPa"]));
 }
 
+// A stroke or a control point dragged off the surface fails the design's validation: the result
+// names the error and shows the last valid design (its fields, incisions and the same cut model),
+// and the designer is kept, so moving back is an edit answered from memory, not a new designer
+// (7-14 s at 45k cells) and a new cut model (whose factor takes 15-25 s).
+TEST(StudioCompute, AnEditOffTheSurfaceShowsTheLastValidDesignAndKeepsTheDesigner) {
+  StudioSession session(fresh_folder("off-surface"), bare_model_case(kCoarseAbdomen));
+  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
+  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
+  for (const json& p : demo["control_points"])
+    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
+                        {"cross_kPa", p["cross_kPa"]}});
+  ResultLog log;
+  StudioCompute compute(session, log.sender());
+  const auto edit = [&](const json& e) {
+    if (!e.is_null()) session.apply_edit(e);
+    compute.design_changed(session.design(), session.seq());
+    compute.wait_idle();
+    std::lock_guard lock(log.mutex);
+    return log.results.back();
+  };
+  const json valid = edit(nullptr);
+  ASSERT_FALSE(valid.contains("design_error"));
+  ASSERT_FALSE(valid["incisions"].empty());
+  const int stroke = session.design().strokes.front().id;
+  const int point = session.design().control_points.front().id;
+  const Vec3 at = session.design().control_points.front().position_mm;
+  const auto expect_last_valid = [&](const json& r, const std::string& what) {
+    SCOPED_TRACE(what);
+    ASSERT_TRUE(r.contains("design_error"));
+    const std::string error = r["design_error"];
+    EXPECT_NE(error.find("from the body surface"), std::string::npos) << error;
+    EXPECT_NE(error.find("; the last valid design is shown"), std::string::npos) << error;
+    EXPECT_EQ(r["surface"]["id"], valid["surface"]["id"]) << "the same cut model: no re-cut";
+    EXPECT_EQ(r["incisions"], valid["incisions"]);
+    EXPECT_EQ(unpacked_floats(r["fields"]["langer_kPa"]), unpacked_floats(valid["fields"]["langer_kPa"]));
+    EXPECT_EQ(unpacked_floats(r["fields"]["direction"]), unpacked_floats(valid["fields"]["direction"]));
+    EXPECT_EQ(r["equilibrium_residual"], valid["equilibrium_residual"]);
+  };
+  expect_last_valid(edit({{"cmd", "move_stroke"}, {"id", stroke}, {"offset_mm", {0.0, 60.0, 0.0}}}), "a stroke off the surface");
+  const json back = edit({{"cmd", "move_stroke"}, {"id", stroke}, {"offset_mm", {0.0, -60.0, 0.0}}});
+  EXPECT_FALSE(back.contains("design_error"));
+  EXPECT_EQ(back["surface"]["id"], valid["surface"]["id"]);
+  EXPECT_EQ(back["timings_ms"]["directions"], 0.0) << "the kept designer recalls the valid design";
+  EXPECT_EQ(back["incisions"], valid["incisions"]);
+  expect_last_valid(edit({{"cmd", "set_control_point"}, {"id", point}, {"position_mm", {at.x(), at.y() + 60.0, at.z()}}}),
+                    "a control point off the surface");
+}
+
 TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBothAgree) {
   StudioSession session(fresh_folder("handoff"), bare_model_case(kCoarseAbdomen));
   const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
