@@ -35,6 +35,17 @@ std::filesystem::path fresh_folder(const std::string& name) {
 
 const json kCoarseAbdomen = {{"source", "abdomen"}, {"resolution", {48, 16, 32}}};
 
+/// Adds the strokes and control points of `cleave demo`'s design on the session's abdomen as
+/// edits; returns that design (the case format's "design" section).
+json add_demo_design(StudioSession& session) {
+  const json design = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
+  for (const json& stroke : design["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
+  for (const json& p : design["control_points"])
+    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
+                        {"cross_kPa", p["cross_kPa"]}});
+  return design;
+}
+
 TEST(StudioCase, TheBareAbdomenGetsTheDemosSettingsFromTheSharedFunction) {
   const json c = bare_model_case(kCoarseAbdomen);
   StudioSession s(fresh_folder("bare"), c);
@@ -65,19 +76,29 @@ TEST(StudioCase, ACaseFileKeepsItsOwnSettings) {
   EXPECT_EQ(bare["design"]["equilibrium_support"], "simulation");
 }
 
+/// The messages a StudioCompute sends (from its worker thread), decoded: every one, or those of
+/// one type.
+struct MessageLog {
+  explicit MessageLog(std::string type = {}) : only_type(std::move(type)) {}
+  std::string only_type;  ///< empty: every message
+  std::mutex mutex;
+  std::vector<json> messages;
+  std::function<void(std::string)> sender() {
+    return [this](std::string text) {
+      json message = wire_decoded(text);
+      std::lock_guard lock(mutex);
+      if (only_type.empty() || message["type"] == only_type) messages.push_back(std::move(message));
+    };
+  }
+};
+
 TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
   StudioSession session(fresh_folder("preview"), bare_model_case(kCoarseAbdomen));
-  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
-  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
-  for (const json& p : demo["control_points"])
-    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
-                        {"cross_kPa", p["cross_kPa"]}});
-  std::mutex m;
-  std::vector<json> sent;
-  StudioCompute compute(session, [&](std::string text) {
-    std::lock_guard lock(m);
-    sent.push_back(wire_decoded(text));
-  });
+  const json demo = add_demo_design(session);
+  MessageLog log;
+  StudioCompute compute(session, log.sender());
+  std::mutex& m = log.mutex;
+  std::vector<json>& sent = log.messages;
   compute.design_changed(session.design(), session.seq());
   compute.wait_idle();
   std::lock_guard lock(m);
@@ -125,26 +146,13 @@ TEST(StudioCompute, PreviewIncisionsOpenAlongLangerAwayFromTheControlPoints) {
   EXPECT_GE(along, static_cast<int>(incisions.size()) * 3 / 4) << "long axes along Langer's lines";
 }
 
-/// The "result" messages a StudioCompute sends (from its worker thread).
-struct ResultLog {
-  std::mutex mutex;
-  std::vector<json> results;
-  std::function<void(std::string)> sender() {
-    return [this](std::string text) {
-      json message = wire_decoded(text);
-      std::lock_guard lock(mutex);
-      if (message["type"] == "result") results.push_back(std::move(message));
-    };
-  }
-};
-
 TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGetsThemAll) {
   StudioSession session(fresh_folder("lean"), bare_model_case(kCoarseAbdomen));
   const json demo = abdomen_demo_case(session.model(), DemoStress::designed);
-  ResultLog log;
+  MessageLog log{"result"};
   StudioCompute compute(session, log.sender());
   std::mutex& m = log.mutex;
-  std::vector<json>& results = log.results;
+  std::vector<json>& results = log.messages;
   const auto edit = [&](const json& e) {
     session.apply_edit(e);
     compute.design_changed(session.design(), session.seq());
@@ -209,7 +217,7 @@ TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) 
   const json add_cut = {{"cmd", "add_cut"}, {"kind", "scalpel"}, {"path_mm", design["strokes"][0]["points"]}, {"depth_mm", 5.0}};
   const auto last_result = [&](const std::string& name, bool cut_first) {
     StudioSession session(fresh_folder(name), bare_model_case(kCoarseAbdomen));
-    ResultLog log;
+    MessageLog log{"result"};
     StudioCompute compute(session, log.sender());
     const auto edit = [&](const json& e, bool recompute) {
       session.apply_edit(e);
@@ -225,7 +233,7 @@ TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) 
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
     std::lock_guard lock(log.mutex);
-    return log.results.back();
+    return log.messages.back();
   };
   const json late = last_result("measure-late", false);
   const json early = last_result("measure-early", true);
@@ -253,17 +261,11 @@ TEST(StudioCompute, APictureFromAProvisionalStressIsFollowedByTheFinalDesign) {
   json free_body = bare_model_case(kCoarseAbdomen);
   free_body["design"]["equilibrium_support"] = "none";
   StudioSession session(fresh_folder("provisional"), free_body);
-  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
-  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
-  for (const json& p : demo["control_points"])
-    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
-                        {"cross_kPa", p["cross_kPa"]}});
-  std::mutex m;
-  std::vector<json> sent;
-  StudioCompute compute(session, [&](std::string text) {
-    std::lock_guard lock(m);
-    sent.push_back(wire_decoded(text));
-  });
+  add_demo_design(session);
+  MessageLog log;
+  StudioCompute compute(session, log.sender());
+  std::mutex& m = log.mutex;
+  std::vector<json>& sent = log.messages;
   const auto recompute = [&] {
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
@@ -323,19 +325,15 @@ TEST(StudioCompute, APictureFromAProvisionalStressIsFollowedByTheFinalDesign) {
 // (7-14 s at 45k cells) and a new cut model (whose factor takes 15-25 s).
 TEST(StudioCompute, AnEditOffTheSurfaceShowsTheLastValidDesignAndKeepsTheDesigner) {
   StudioSession session(fresh_folder("off-surface"), bare_model_case(kCoarseAbdomen));
-  const json demo = abdomen_demo_case(session.model(), DemoStress::designed)["design"];
-  for (const json& stroke : demo["strokes"]) session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", stroke["points"]}});
-  for (const json& p : demo["control_points"])
-    session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", p["langer_kPa"]},
-                        {"cross_kPa", p["cross_kPa"]}});
-  ResultLog log;
+  add_demo_design(session);
+  MessageLog log{"result"};
   StudioCompute compute(session, log.sender());
   const auto edit = [&](const json& e) {
     if (!e.is_null()) session.apply_edit(e);
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
     std::lock_guard lock(log.mutex);
-    return log.results.back();
+    return log.messages.back();
   };
   const json valid = edit(nullptr);
   ASSERT_FALSE(valid.contains("design_error"));
@@ -371,10 +369,10 @@ TEST(StudioCompute, ANewCutModelIsSolvedByTheMultigridUntilItsFactorIsReadyAndBo
   session.apply_edit({{"cmd", "add_stroke"}, {"points_mm", demo["strokes"][0]["points"]}});
   const json& p = demo["control_points"][0];
   session.apply_edit({{"cmd", "add_control_point"}, {"position_mm", p["position"]}, {"langer_kPa", 20}, {"cross_kPa", 10}});
-  ResultLog log;
+  MessageLog log{"result"};
   StudioCompute compute(session, log.sender());
   std::mutex& m = log.mutex;
-  std::vector<json>& results = log.results;
+  std::vector<json>& results = log.messages;
   const auto latest = [&] {
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
