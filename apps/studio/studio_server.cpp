@@ -61,6 +61,8 @@ struct StudioServer::Impl {
   Impl(StudioSession& s, ServerOptions o, ServerHooks h) : session(s), options(std::move(o)), hooks(std::move(h)) {}
   void accept();
   void broadcast_now(const std::shared_ptr<const std::string>& text);
+  /// The state after an edit, to every client (WsClient::send_state).
+  void broadcast_state(const std::shared_ptr<const std::string>& text);
   nlohmann::json handle_text(const std::string& text, bool& design_changed);
 };
 
@@ -84,16 +86,21 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     });
   }
 
-  void send(std::shared_ptr<const std::string> text) {
+  void send(std::shared_ptr<const std::string> text) { enqueue(std::move(text), false); }
+
+  /// A broadcast "state" (the whole design after an edit): only the newest matters, so one still
+  /// waiting in the queue (not the one being written) is replaced by it in place. It stays ahead
+  /// of the sender's acknowledgement, which is queued after it; a client that reads slowly during
+  /// a burst of edits from other clients holds one state, not one per edit.
+  void send_state(std::shared_ptr<const std::string> text) {
     if (closed_) return;
-    // A client that does not read: drop it before its queue holds every result since.
-    if (queue_.size() >= kMaxQueuedMessages || queued_bytes_ + text->size() > server_.options.max_queued_bytes) {
-      close();
+    for (std::size_t i = queue_.size(); i-- > 1;) {  // queue_[0] is being written
+      if (!queue_[i].state) continue;
+      queued_bytes_ = queued_bytes_ - queue_[i].text->size() + text->size();
+      queue_[i].text = std::move(text);
       return;
     }
-    queued_bytes_ += text->size();
-    queue_.push_back(std::move(text));
-    if (queue_.size() == 1) write_next();
+    enqueue(std::move(text), true);
   }
 
  private:
@@ -115,7 +122,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
         // The new state reaches every client before the sender's acknowledgement, so a client
         // that acts on the ack already holds the state it acknowledges.
         if (design_changed)
-          self->server_.broadcast_now(std::make_shared<const std::string>(self->server_.session.state_message().dump()));
+          self->server_.broadcast_state(std::make_shared<const std::string>(self->server_.session.state_message().dump()));
         self->send(std::make_shared<const std::string>(reply.dump()));
         if (is_hello && self->server_.hooks.welcome_messages)
           for (std::string& m : self->server_.hooks.welcome_messages())
@@ -126,14 +133,28 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     });
   }
 
+  void enqueue(std::shared_ptr<const std::string> text, bool state) {
+    if (closed_) return;
+    // A client that does not read: drop it before its queue holds every result since.
+    if (queue_.size() >= kMaxQueuedMessages || queued_bytes_ + text->size() > server_.options.max_queued_bytes) {
+      close();
+      return;
+    }
+    queued_bytes_ += text->size();
+    queue_.push_back({std::move(text), state});
+    if (queue_.size() == 1) write_next();
+  }
+
   void write_next() {
-    ws_.binary(is_binary_wire(*queue_.front()));
-    ws_.async_write(net::buffer(*queue_.front()), [self = shared_from_this()](beast::error_code ec, std::size_t) {
+    // The message being written is kept alive by the queue's front until its write completes.
+    const std::string& text = *queue_.front().text;
+    ws_.binary(is_binary_wire(text));
+    ws_.async_write(net::buffer(text), [self = shared_from_this()](beast::error_code ec, std::size_t) {
       if (ec || self->closed_) {  // closed meanwhile (queue emptied): a write that still completed
         self->close();
         return;
       }
-      self->queued_bytes_ -= self->queue_.front()->size();
+      self->queued_bytes_ -= self->queue_.front().text->size();
       self->queue_.pop_front();
       if (!self->queue_.empty()) self->write_next();
     });
@@ -153,7 +174,11 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   websocket::stream<beast::tcp_stream> ws_;
   StudioServer::Impl& server_;
   beast::flat_buffer buffer_;
-  std::deque<std::shared_ptr<const std::string>> queue_;
+  struct Queued {
+    std::shared_ptr<const std::string> text;
+    bool state = false;  ///< a broadcast state, which a newer one replaces while unsent
+  };
+  std::deque<Queued> queue_;
   std::size_t queued_bytes_ = 0;  ///< of the messages in queue_ (the one being written included)
   bool closed_ = false;
 };
@@ -277,6 +302,11 @@ void StudioServer::Impl::accept() {
 void StudioServer::Impl::broadcast_now(const std::shared_ptr<const std::string>& text) {
   const auto copy = clients;  // send() may drop a client from the set
   for (const auto& c : copy) c->send(text);
+}
+
+void StudioServer::Impl::broadcast_state(const std::shared_ptr<const std::string>& text) {
+  const auto copy = clients;  // send_state() may drop a client from the set
+  for (const auto& c : copy) c->send_state(text);
 }
 
 nlohmann::json StudioServer::Impl::handle_text(const std::string& text, bool& design_changed) {

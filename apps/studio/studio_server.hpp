@@ -14,7 +14,8 @@
 // Limits: request headers 8 KiB, bodies kMaxHttpBodyBytes, WebSocket messages kMaxMessageBytes;
 // a client whose send queue exceeds kMaxQueuedMessages messages or ServerOptions::max_queued_bytes
 // (a client that stopped reading: results at 45k cells are ~2.5 MB each) is disconnected; the
-// others go on.
+// others go on. A broadcast state still unsent to a client is replaced by a newer one (only the
+// newest design matters), so a burst of edits by other clients does not fill a slow reader's queue.
 #include <cstdint>
 #include <filesystem>
 #include <functional>

@@ -206,15 +206,72 @@ test('a client that stops reading is dropped at the send-queue byte budget; the 
   }
 });
 
+// A client that reads slowly while another one edits in a burst: the broadcast states it has not
+// been sent yet are replaced by the newest (only the newest design matters), so 600 edits, more
+// than the 512 queued messages that drop a client, leave it connected; once it reads, it gets far
+// fewer states than edits, the last one the newest. Results first fill what the kernel buffers
+// for it (a few MB on loopback), so that the server's own queue holds the states.
+test('a slow reader gets the newest state instead of one per edit', { timeout: 180000 }, async () => {
+  const server = await startServer({ bin: tools.bin, session: freshSessionDir('coalesce'), res: '48x16x32' });
+  try {
+    const stalled = await openStalledClient(server.port);
+    let stalledClosed = false;
+    stalled.on('close', () => { stalledClosed = true; });
+    const ws = await openSocket(server.url);
+    assert.equal((await request(ws, { cmd: 'add_control_point', position_mm: [0, 0, 0], langer_kPa: 20, cross_kPa: 10 })).type, 'ack');
+    const id = (await request(ws, { cmd: 'get_state' })).design.control_points[0].id;
+    let resultBytes = 0;
+    let waitResult = null;
+    ws.onpush = (m) => { if (m.type === 'result' && waitResult) waitResult(); };
+    const rawHandler = ws.onmessage;
+    ws.onmessage = (e) => { if (typeof e.data !== 'string') resultBytes = Math.max(resultBytes, e.data.byteLength); rawHandler(e); };
+    let filling = 0;
+    let before = 0;
+    for (; filling < 200 && !(filling >= 8 && filling * resultBytes > (24 << 20)); filling++) {
+      const arrived = new Promise((resolve) => { waitResult = resolve; });
+      before = (await request(ws, { cmd: 'set_control_point', id, langer_kPa: 30 + (filling % 40) })).seq;
+      await arrived;
+    }
+    const EDITS = 600;
+    let last = 0;
+    for (let e = 0; e < EDITS; e++) {
+      const ack = await request(ws, { cmd: 'set_control_point', id, langer_kPa: 21 + (e % 40) });
+      assert.equal(ack.type, 'ack', JSON.stringify(ack));
+      last = ack.seq;
+    }
+    assert.equal((await request(ws, { cmd: 'ping' })).type, 'pong');
+    ws.close();
+    // Read what was queued for the stalled client until it stays quiet for a second.
+    const chunks = [];
+    stalled.on('data', (c) => chunks.push(c));
+    stalled.resume();
+    let size = -1;
+    while (size !== chunks.length) { size = chunks.length; await new Promise((r) => setTimeout(r, 1000)); }
+    assert.ok(!stalledClosed, 'the slow reader was dropped');
+    const text = Buffer.concat(chunks).toString('latin1');
+    const states = [...text.matchAll(/"type":"state"/g)].length;
+    const seqs = [...text.matchAll(/"seq":(\d+),"type":"state"|"type":"state"[^}]*?"seq":(\d+)/g)].map((m) => Number(m[1] ?? m[2]));
+    const burst = seqs.filter((s) => s > before).length;
+    assert.ok(states < (filling + EDITS) / 4, `${states} states for ${filling + EDITS} edits`);
+    assert.ok(burst < EDITS / 4, `${burst} states for the burst's ${EDITS} edits`);
+    assert.ok(seqs.includes(last), `the newest state (seq ${last}) among ${seqs.slice(-5)}`);
+    stalled.destroy();
+  } finally {
+    await server.stop();
+  }
+});
+
 test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknowledged edit`, { timeout: (SOAK_SECONDS + 90) * 1000 }, async () => {
   const session = freshSessionDir('soak');
   const soak = await startServer({ bin: tools.bin, session });
   const acked = [];
   let errors = 0;
+  let clients = [];
+  let sampler = null;
   try {
-    const clients = await Promise.all(Array.from({ length: SOAK_CLIENTS }, () => openSocket(soak.url)));
+    clients = await Promise.all(Array.from({ length: SOAK_CLIENTS }, () => openSocket(soak.url)));
     const rss = [];
-    const sampler = setInterval(() => rss.push(rssMiB(soak.process.pid)), 500);
+    sampler = setInterval(() => rss.push(rssMiB(soak.process.pid)), 500);
     const deadline = Date.now() + SOAK_SECONDS * 1000;
     await Promise.all(clients.map(async (ws, c) => {
       let i = 0;
@@ -256,6 +313,9 @@ test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknow
       `RSS MiB first ${rss[0].toFixed(1)}, second-quarter median ${warm.toFixed(1)}, last-quarter median ${last.toFixed(1)}, ` +
       `max ${Math.max(...rss).toFixed(1)} (${rss.length} samples)`);
   } finally {
+    // A failure above must not leave the sampler or the sockets keeping this file's process alive.
+    clearInterval(sampler);
+    for (const ws of clients) ws.close();
     await soak.stop();
   }
 });
