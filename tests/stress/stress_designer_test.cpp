@@ -107,9 +107,9 @@ TEST(Designer, AnEditBackToOneOfTheLastTwoDesignsIsAnsweredFromMemory) {
 // The picture first: a stroke dragged over fresh cells of the abdomen, edit by edit, by two
 // designers. One completes each edit (set_design), the other draws from a provisional stress
 // (EquilibrationPass::picture) and completes it afterwards (finish_equilibration): after that
-// every result is the first designer's, bit for bit, the provisional one was within what the
-// picture resolves, and an edit back is answered from memory as for the complete pass.
-TEST(Designer, APictureFirstThenTheFinishedEquilibrationIsTheCompleteEditBitForBit) {
+// every result is the first designer's (to rounding: see below), the provisional one was within
+// what the picture resolves, and an edit back is answered from memory as for the complete pass.
+TEST(Designer, APictureFirstThenTheFinishedEquilibrationIsTheCompleteEdit) {
   const TissueModel m = test::builtin_model("abdomen");
   StressDesign d = test::abdomen_demo_design(m);
   d.equilibration = Equilibration::growth;
@@ -132,18 +132,21 @@ TEST(Designer, APictureFirstThenTheFinishedEquilibrationIsTheCompleteEditBitForB
       picture.finish_equilibration();
     }
     EXPECT_FALSE(picture.result().provisional);
-    EXPECT_TRUE(picture.result().stress_kPa == whole.stress_kPa) << "edit " << edit;
-    EXPECT_EQ(picture.result().equilibration_iterations, whole.equilibration_iterations);
-    EXPECT_EQ(picture.result().residual_final, whole.residual_final);
+    // Two designers agree to rounding, not bit for bit: the direction stage chooses between its
+    // kept factor and CG by measured times (the ASan build chose differently at edit 4). The
+    // equilibration's own bit-for-bit equality is Equilibration.APictureFirstThenFinish...
+    EXPECT_LT(relative_difference(picture.result(), whole), 1e-8) << "edit " << edit;
+    EXPECT_NEAR(picture.result().residual_final, whole.residual_final, 0.5 * whole.residual_final) << "edit " << edit;
+    const std::vector<Vec6> finished = picture.result().stress_kPa;
     picture.finish_equilibration();  // nothing left to do
-    EXPECT_TRUE(picture.result().stress_kPa == whole.stress_kPa);
+    EXPECT_TRUE(picture.result().stress_kPa == finished);
   }
   EXPECT_GE(provisional_edits, 1) << "no edit over fresh cells stopped for the picture";
   // The last two designs are remembered once finished; a provisional one is not until then.
   picture.set_design(d, EquilibrationPass::picture);
   picture.finish_equilibration();
   complete.set_design(d);
-  EXPECT_TRUE(picture.result().stress_kPa == complete.result().stress_kPa);
+  EXPECT_LT(relative_difference(picture.result(), complete.result()), 1e-8);
   StressDesign last = d;
   last.strokes[0].points_mm.clear();
   for (int i = 1; i <= 9; ++i) last.strokes[0].points_mm.push_back(test::skin_point(m, 0.1 * i * w, 0.2 * l + 4 * h));
