@@ -57,13 +57,6 @@ StressDesign design_settings(const CaseFile& case_file) {
   return parse_design_settings_json(*section, case_file.at("design"));
 }
 
-bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b) {
-  if (a.size() != b.size()) return false;
-  for (std::size_t i = 0; i < a.size(); ++i)
-    if (a[i].placement != b[i].placement || a[i].points_mm != b[i].points_mm) return false;
-  return true;
-}
-
 /// Triangle indices of `surface` without the hidden plugs of the round incisions.
 std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const CutPlan& plan) {
   std::vector<std::uint8_t> hidden(surface.quad_of_face.size() / 6, 0);

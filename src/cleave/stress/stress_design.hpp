@@ -20,6 +20,9 @@ struct DesignStroke {
   StrokePlacement placement = StrokePlacement::surface;
 };
 
+/// The same strokes, compared exactly (placement and every point), in the same order.
+bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b);
+
 /// Eigenvalues prescribed at a surface point (paper fig. 4); the normal eigenvalue there is 0.
 struct DesignControlPoint {
   Vec3 position_mm = Vec3::Zero();

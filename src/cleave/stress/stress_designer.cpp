@@ -39,14 +39,14 @@ bool same_control_points(const std::vector<DesignControlPoint>& a, const std::ve
   return true;
 }
 
+}  // namespace
+
 bool same_strokes(const std::vector<DesignStroke>& a, const std::vector<DesignStroke>& b) {
   if (a.size() != b.size()) return false;
   for (std::size_t i = 0; i < a.size(); ++i)
     if (a[i].placement != b[i].placement || a[i].points_mm != b[i].points_mm) return false;
   return true;
 }
-
-}  // namespace
 
 struct StressDesigner::Operators {
   Operators(const TissueModel& model, const DesignWeights& weights, const std::vector<VertexId>& held)
