@@ -74,25 +74,42 @@ TEST(ForwardColumnBatches, EachEditGetsTheProductsOfItsWholeColumns) {
   EXPECT_EQ(kept.columns(), 34U);
 }
 
-// At most 40 columns: a third stroke of 16 rows beside 2 x 16 kept ones forgets them, and an edit
-// with those rows again makes them anew.
+// At most 40 columns beside 2 x 16 kept ones: an edit with a's rows and a third stroke's c
+// forgets b's batch (unused), not a's; an edit of b alone then makes b anew and forgets a's. An
+// edit that the unused batches cannot make room for (a, b and c with the bound at 40) forgets all
+// and makes all its rows. Each edit's products equal those of its whole columns after the
+// renumbering.
 TEST(ForwardColumnBatches, KeptColumnsGiveWayPastTheBound) {
   test::LinearSystem s = block_system();
   test::CholmodFactor chol(s.a);
   const SupernodalSubstitution sub(chol.factor());
   const std::vector<Eigen::Index> a = range(10, 16, 5), b = range(900, 16, 5), c = range(2000, 16, 5);
   ForwardColumnBatches kept(40, 256.0 * 1024 * 1024);
+  const auto expect_whole_products = [&](const std::vector<Eigen::Index>& changed) {
+    const ForwardColumnBatches::Selection edit = kept.select(changed);
+    const Eigen::MatrixXd w = whole_columns(sub, chol.factor(), changed);
+    EXPECT_LT(relative_difference(edit.gram(), w.transpose() * w), 1e-12);
+  };
   EXPECT_EQ(kept.make(sub, chol.factor(), a), 16);
   EXPECT_EQ(kept.make(sub, chol.factor(), b), 16);
+  expect_whole_products(joined(a, b));
   EXPECT_EQ(kept.rows_to_make(c).size(), 16U);
-  EXPECT_EQ(kept.rows_to_make(joined(a, c)).size(), 32U) << "past the bound: all the edit's rows";
-  EXPECT_EQ(kept.make(sub, chol.factor(), joined(a, c)), 32);
+  EXPECT_EQ(kept.rows_to_make(joined(a, c)).size(), 16U) << "b's batch gives way: only c's rows";
+  EXPECT_EQ(kept.make(sub, chol.factor(), joined(a, c)), 16);
   EXPECT_EQ(kept.columns(), 32U);
-  EXPECT_EQ(kept.batches(), 1U);
+  EXPECT_EQ(kept.batches(), 2U);
+  expect_whole_products(joined(a, c));
+  expect_whole_products(c);
   EXPECT_EQ(kept.make(sub, chol.factor(), b), 16) << "b's columns were forgotten";
-  const ForwardColumnBatches::Selection edit = kept.select(b);
-  const Eigen::MatrixXd w = whole_columns(sub, chol.factor(), b);
-  EXPECT_LT(relative_difference(edit.gram(), w.transpose() * w), 1e-12);
+  EXPECT_EQ(kept.batches(), 2U) << "a's batch, the oldest unused, gave way";
+  EXPECT_EQ(kept.rows_to_make(a).size(), 16U);
+  expect_whole_products(joined(c, b));
+  const std::vector<Eigen::Index> all = joined(joined(c, b), a);
+  EXPECT_EQ(kept.rows_to_make(all).size(), 48U) << "no unused batch to forget: all the edit's rows";
+  EXPECT_EQ(kept.make(sub, chol.factor(), all), 48);
+  EXPECT_EQ(kept.batches(), 1U);
+  expect_whole_products(all);
+  expect_whole_products(b);
   kept.clear();
   EXPECT_EQ(kept.columns(), 0U);
   EXPECT_EQ(kept.rows_to_make(a).size(), 16U);

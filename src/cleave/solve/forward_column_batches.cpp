@@ -49,7 +49,58 @@ double ForwardColumnBatches::estimated_reach() const {
 
 std::vector<Eigen::Index> ForwardColumnBatches::rows_to_make(const std::vector<Eigen::Index>& changed) const {
   std::vector<Eigen::Index> missing = missing_rows(changed);
-  return overflow(missing.size(), estimated_reach()) ? changed : missing;
+  if (!overflow(missing.size(), estimated_reach())) return missing;
+  return batches_to_forget(changed, missing.size(), estimated_reach()).empty() ? changed : missing;
+}
+
+std::vector<bool> ForwardColumnBatches::batches_to_forget(const std::vector<Eigen::Index>& changed, std::size_t added,
+                                                          double added_rows) const {
+  std::vector<bool> used(batches_.size(), false);
+  for (const Eigen::Index r : changed) {
+    const int column = column_of_row_.empty() ? -1 : column_of_row_[static_cast<std::size_t>(r)];
+    if (column >= 0) used[static_cast<std::size_t>(batch_of_column_[static_cast<std::size_t>(column)])] = true;
+  }
+  std::vector<bool> drop(batches_.size(), false);
+  std::size_t columns_left = columns();
+  double bytes_left = bytes_;
+  const auto fits = [&] {
+    return columns_left + added <= max_columns_ && bytes_left + kBytesPerValue * added_rows * static_cast<double>(added) <= max_bytes_;
+  };
+  for (std::size_t b = 0; b < batches_.size() && !fits(); ++b) {
+    if (used[b]) continue;
+    drop[b] = true;
+    columns_left -= static_cast<std::size_t>(batches_[b].w.cols());
+    bytes_left -= kBytesPerValue * static_cast<double>(batches_[b].w.size());
+  }
+  if (!fits()) return {};
+  return drop;
+}
+
+void ForwardColumnBatches::forget(const std::vector<bool>& drop) {
+  std::vector<int> new_of_old(columns(), -1);
+  std::vector<Eigen::Index> kept_old;
+  std::vector<Batch> batches;
+  batch_of_column_.clear();
+  for (std::size_t b = 0; b < batches_.size(); ++b) {
+    Batch& batch = batches_[b];
+    if (drop[b]) {
+      bytes_ -= kBytesPerValue * static_cast<double>(batch.w.size());
+      continue;
+    }
+    const auto first_kept = static_cast<Eigen::Index>(kept_old.size());
+    for (Eigen::Index c = 0; c < batch.w.cols(); ++c) {
+      new_of_old[static_cast<std::size_t>(batch.first_column + c)] = static_cast<int>(kept_old.size());
+      kept_old.push_back(batch.first_column + c);
+      batch_of_column_.push_back(static_cast<int>(batches.size()));
+    }
+    batch.first_column = first_kept;
+    batches.push_back(std::move(batch));
+  }
+  batches_ = std::move(batches);
+  for (int& column : column_of_row_)
+    if (column >= 0) column = new_of_old[static_cast<std::size_t>(column)];
+  gram_ = Eigen::MatrixXd(gram_(kept_old, kept_old));
+  known_ = decltype(known_)(known_(kept_old, kept_old));
 }
 
 bool ForwardColumnBatches::overflow(std::size_t added, double added_rows) const {
@@ -70,10 +121,19 @@ int ForwardColumnBatches::make(const SupernodalSubstitution& substitution, const
                                const std::vector<Eigen::Index>& changed) {
   std::vector<Eigen::Index> missing = missing_rows(changed);
   if (missing.empty()) return 0;
-  if (overflow(missing.size(), estimated_reach())) {
-    clear();
-    missing = changed;
-  }
+  // Past the bounds the kept batches this edit does not use give way; all of them when that is
+  // not enough (then every changed row gets its column anew, in this batch).
+  const auto make_room = [&](double added_rows) {
+    if (!overflow(missing.size(), added_rows)) return true;
+    const std::vector<bool> drop = batches_to_forget(changed, missing.size(), added_rows);
+    if (drop.empty()) {
+      clear();
+      return false;
+    }
+    forget(drop);
+    return true;
+  };
+  if (!make_room(estimated_reach())) missing = changed;
   Batch batch;
   batch.w = substitution.forward_unit_columns(factor, missing, batch.reached);
   if (!batch.w.allFinite()) {
@@ -81,10 +141,8 @@ int ForwardColumnBatches::make(const SupernodalSubstitution& substitution, const
     return -1;
   }
   // A batch that reached more rows than estimated: the kept ones give way.
-  if (overflow(missing.size(), static_cast<double>(batch.reached.size()))) {
-    clear();
-    if (missing.size() != changed.size()) return make(substitution, factor, changed);
-  }
+  if (!make_room(static_cast<double>(batch.reached.size())) && missing.size() != changed.size())
+    return make(substitution, factor, changed);
   if (column_of_row_.empty()) column_of_row_.assign(substitution.order(), -1);
   const auto kept = static_cast<Eigen::Index>(columns());
   const auto added = static_cast<Eigen::Index>(missing.size());

@@ -26,12 +26,14 @@ class SupernodalSubstitution;
 
 class ForwardColumnBatches {
  public:
-  /// At most `max_columns` columns and `max_bytes` of them; past either, make() forgets the kept
-  /// ones first.
+  /// At most `max_columns` columns and `max_bytes` of them; past either, make() first forgets the
+  /// kept batches the edit does not use, oldest first (a stroke dragged on: the batches of the
+  /// places it has left; its first place, whose rows every drag changes back, stays), and all of
+  /// them only when that is not enough.
   ForwardColumnBatches(std::size_t max_columns, double max_bytes) : max_columns_(max_columns), max_bytes_(max_bytes) {}
 
   /// The rows of `changed` without a column, or all of them when their columns would exceed the
-  /// bounds beside the kept ones (make() then forgets those).
+  /// bounds even without the kept batches the edit does not use (make() then forgets all).
   std::vector<Eigen::Index> rows_to_make(const std::vector<Eigen::Index>& changed) const;
   /// Makes the columns of rows_to_make(changed) as one batch. Returns how many it made, or -1 when
   /// they are not finite (then nothing is kept).
@@ -84,6 +86,12 @@ class ForwardColumnBatches {
   double estimated_reach() const;
   /// Whether `added` more columns, reaching `added_rows` rows, exceed the bounds beside the kept ones.
   bool overflow(std::size_t added, double added_rows) const;
+  /// The batches to forget, oldest first among those none of whose columns `changed` uses, so that
+  /// `added` columns reaching `added_rows` rows fit (per batch: true to forget); empty when
+  /// forgetting all of those is not enough.
+  std::vector<bool> batches_to_forget(const std::vector<Eigen::Index>& changed, std::size_t added, double added_rows) const;
+  /// Forgets the batches marked in `forget`; the kept columns are renumbered in their order.
+  void forget(const std::vector<bool>& forget);
   /// Fills gram_ and known_ for every pair of the columns `columns` of batches `first` and `second`.
   void make_products(std::size_t first, const std::vector<Eigen::Index>& first_columns, std::size_t second,
                      const std::vector<Eigen::Index>& second_columns);
