@@ -2,7 +2,7 @@
 // The studio's edit-to-result time as a client sees it, over the WebSocket of a running server:
 //
 //   build/release/bin/cleave studio abdomen --res 126x41x84 --session /tmp/s --port 8765 &
-//   node --experimental-websocket scripts/studio-timings.mjs ws://127.0.0.1:8765/ws [DRAGS]
+//   node --experimental-websocket scripts/studio-timings.mjs ws://127.0.0.1:8765/ws [DRAGS] [SETTLE_S]
 //
 // On a bare session it designs what `cleave demo` designs on the abdomen (three strokes along x
 // over the skin at 20, 50 and 80 % of its length, four control points of 20 / 10 kPa), then moves
@@ -11,10 +11,15 @@
 // waits for each edit's result. It prints, per edit, the time from sending the edit to its result
 // arriving (received and decoded, before any drawing), the server's own stage times, and, when
 // the picture came from a provisional stress, when its design_final arrived; then the medians.
+// SETTLE_S (default 30) seconds pass between the design and the first drag: the incision
+// preview's factorization runs in the background for 15-30 s at 45k cells after the design, and
+// until it is ready the preview is solved by the multigrid (200-350 ms). The drags follow the
+// skin for about 12 cells; start each run on a fresh session.
 import { decodeMessage } from '../web/js/packed.js';
 
 const url = process.argv[2];
 const drags = Number(process.argv[3] ?? 8);
+const settleS = Number(process.argv[4] ?? 30);
 if (!url || !(drags > 0)) {
   console.error('usage: studio-timings.mjs ws://127.0.0.1:PORT/ws [DRAGS]');
   process.exit(2);
@@ -92,6 +97,8 @@ if (state.design.strokes.length === 0) {
   await waitFor((m) => m.type === 'result' && m.seq >= ack.seq);
   console.log(`design: ${(performance.now() - started).toFixed(0)} ms to its first result (${latestResult.cells} cells)`);
   state = await request('get_state');
+  console.log(`waiting ${settleS} s for the preview's factorization`);
+  await new Promise((resolve) => setTimeout(resolve, 1000 * settleS));
 }
 const stroke = state.design.strokes[0].id;
 let middle = state.design.strokes[0].points_mm[Math.floor(state.design.strokes[0].points_mm.length / 2)];
