@@ -20,8 +20,8 @@ import { decodeMessage } from '../web/js/packed.js';
 const url = process.argv[2];
 const drags = Number(process.argv[3] ?? 8);
 const settleS = Number(process.argv[4] ?? 30);
-if (!url || !(drags > 0)) {
-  console.error('usage: studio-timings.mjs ws://127.0.0.1:PORT/ws [DRAGS]');
+if (!url || !(drags > 0) || !(settleS >= 0)) {
+  console.error('usage: studio-timings.mjs ws://127.0.0.1:PORT/ws [DRAGS] [SETTLE_S]');
   process.exit(2);
 }
 
