@@ -91,20 +91,26 @@ void StudioCompute::publish_result(nlohmann::json message) {
                              {"started", worker_->jobs_started()},
                              {"skipped", worker_->jobs_skipped()},
                              {"published", ++results_published_}};
-  // The connected clients hold the triangles of the surface they were last sent (every
-  // result reaches every client; one that connects later gets latest_result_ in full).
+  // The connected clients hold the triangles and the cut faces' depths of the surface they were
+  // last sent (both are made with the surface; every result reaches every client; one that
+  // connects later gets latest_result_ in full).
   nlohmann::json& surface = message["surface"];
-  nlohmann::json triangles;
+  nlohmann::json triangles, cut_depth;
   if (surface.is_object()) {
     const std::string id = surface.value("id", "");
     if (id == broadcast_surface_id_ && surface.contains("triangles")) {
       triangles = std::move(surface["triangles"]);
       surface.erase("triangles");
+      if (message.contains("fields") && message["fields"].contains("cut_depth")) {
+        cut_depth = std::move(message["fields"]["cut_depth"]);
+        message["fields"].erase("cut_depth");
+      }
     }
     broadcast_surface_id_ = id;
   }
   std::string text = wire_encoded(message);
   if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
+  if (!cut_depth.is_null()) message["fields"]["cut_depth"] = std::move(cut_depth);
   {
     std::lock_guard lock(latest_mutex_);
     latest_result_ = std::move(message);

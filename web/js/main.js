@@ -31,19 +31,22 @@ function setMessage(text, isError = false) {
   if (isError) app.lastError = text;
 }
 
-/// The server leaves a result's triangles out when its surface (surface.id) is the one it sent
-/// before; they are taken from the last result that had them. A result for a surface this page
-/// never got (it connected in between) is skipped and the full latest result asked for (hello).
-const surfaceCache = { id: null, triangles: null };
+/// The server leaves a result's triangles and cut-face depths out when its surface (surface.id)
+/// is the one it sent before; they are taken from the last result that had them. A result for a
+/// surface this page never got (it connected in between) is skipped and the full latest result
+/// asked for (hello).
+const surfaceCache = { id: null, triangles: null, cutDepth: null };
 function withTriangles(m) {
   const s = m.surface;
   if (s.triangles) {
     surfaceCache.id = s.id;
     surfaceCache.triangles = s.triangles;
+    surfaceCache.cutDepth = (m.fields && m.fields.cut_depth) || null;
     return true;
   }
   if (s.id !== undefined && s.id === surfaceCache.id) {
     s.triangles = surfaceCache.triangles;
+    if (surfaceCache.cutDepth && m.fields && !m.fields.cut_depth) m.fields.cut_depth = surfaceCache.cutDepth;
     return true;
   }
   connection.request('hello').catch(() => {});
