@@ -63,9 +63,7 @@ std::vector<bool> ForwardColumnBatches::batches_to_forget(const std::vector<Eige
   std::vector<bool> drop(batches_.size(), false);
   std::size_t columns_left = columns();
   double bytes_left = bytes_;
-  const auto fits = [&] {
-    return columns_left + added <= max_columns_ && bytes_left + kBytesPerValue * added_rows * static_cast<double>(added) <= max_bytes_;
-  };
+  const auto fits = [&] { return !exceeds_bounds(columns_left, bytes_left, added, added_rows); };
   for (std::size_t b = 0; b < batches_.size() && !fits(); ++b) {
     if (used[b]) continue;
     drop[b] = true;
@@ -103,9 +101,13 @@ void ForwardColumnBatches::forget(const std::vector<bool>& drop) {
   known_ = decltype(known_)(known_(kept_old, kept_old));
 }
 
+bool ForwardColumnBatches::exceeds_bounds(std::size_t kept_columns, double kept_bytes, std::size_t added, double added_rows) const {
+  return kept_columns + added > max_columns_ || kept_bytes + kBytesPerValue * added_rows * static_cast<double>(added) > max_bytes_;
+}
+
 bool ForwardColumnBatches::overflow(std::size_t added, double added_rows) const {
   if (added == 0 || batches_.empty()) return false;
-  return columns() + added > max_columns_ || bytes_ + kBytesPerValue * added_rows * static_cast<double>(added) > max_bytes_;
+  return exceeds_bounds(columns(), bytes_, added, added_rows);
 }
 
 void ForwardColumnBatches::clear() {

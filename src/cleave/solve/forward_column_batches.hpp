@@ -84,6 +84,9 @@ class ForwardColumnBatches {
   std::vector<Eigen::Index> missing_rows(const std::vector<Eigen::Index>& changed) const;
   /// Rows a new batch is expected to reach: as many as the largest kept one.
   double estimated_reach() const;
+  /// Whether `added` more columns, reaching `added_rows` rows, exceed the bounds beside
+  /// `kept_columns` columns of `kept_bytes`.
+  bool exceeds_bounds(std::size_t kept_columns, double kept_bytes, std::size_t added, double added_rows) const;
   /// Whether `added` more columns, reaching `added_rows` rows, exceed the bounds beside the kept ones.
   bool overflow(std::size_t added, double added_rows) const;
   /// The batches to forget, oldest first among those none of whose columns `changed` uses, so that
