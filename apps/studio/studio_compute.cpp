@@ -1,5 +1,6 @@
 #include "studio/studio_compute.hpp"
 
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <fmt/format.h>
@@ -91,26 +92,24 @@ void StudioCompute::publish_result(nlohmann::json message) {
                              {"started", worker_->jobs_started()},
                              {"skipped", worker_->jobs_skipped()},
                              {"published", ++results_published_}};
-  // The connected clients hold the triangles and the cut faces' depths of the surface they were
-  // last sent (both are made with the surface; every result reaches every client; one that
-  // connects later gets latest_result_ in full).
-  nlohmann::json& surface = message["surface"];
-  nlohmann::json triangles, cut_depth;
-  if (surface.is_object()) {
-    const std::string id = surface.value("id", "");
-    if (id == broadcast_surface_id_ && surface.contains("triangles")) {
-      triangles = std::move(surface["triangles"]);
-      surface.erase("triangles");
-      if (message.contains("fields") && message["fields"].contains("cut_depth")) {
-        cut_depth = std::move(message["fields"]["cut_depth"]);
-        message["fields"].erase("cut_depth");
+  // The connected clients hold the parts of the surface they were last sent that are made with
+  // it (every result reaches every client; one that connects later gets latest_result_ in full):
+  // a result on that surface goes out without them.
+  static const std::array<nlohmann::json::json_pointer, 2> kSurfaceParts = {nlohmann::json::json_pointer("/surface/triangles"),
+                                                                            nlohmann::json::json_pointer("/fields/cut_depth")};
+  std::vector<std::pair<const nlohmann::json::json_pointer*, nlohmann::json>> held;
+  if (message["surface"].is_object()) {
+    const std::string id = message["surface"].value("id", "");
+    if (id == broadcast_surface_id_)
+      for (const nlohmann::json::json_pointer& part : kSurfaceParts) {
+        if (!message.contains(part)) continue;
+        held.emplace_back(&part, std::move(message[part]));
+        message[part.parent_pointer()].erase(part.back());
       }
-    }
     broadcast_surface_id_ = id;
   }
   std::string text = wire_encoded(message);
-  if (!triangles.is_null()) surface["triangles"] = std::move(triangles);
-  if (!cut_depth.is_null()) message["fields"]["cut_depth"] = std::move(cut_depth);
+  for (auto& [part, value] : held) message[*part] = std::move(value);
   {
     std::lock_guard lock(latest_mutex_);
     latest_result_ = std::move(message);
