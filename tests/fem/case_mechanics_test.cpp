@@ -52,7 +52,7 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(defaults.numerical_damping, 0.2);
   const SimulationSettings s = parse_simulation_settings(case_from(
       R"(, "simulation": {"mode": "dynamic", "solver": "cholmod", "tolerance": 1e-9, "time_step_s": 0.002, "steps": 50,
-          "steps_per_frame": 5, "frames_every": 2, "damping": {"mass_per_s": 3, "stiffness_s": 0.01, "numerical": 0},
+          "steps_per_frame": 5, "frames_every": 2, "iterations_per_step": 4, "damping": {"mass_per_s": 3, "stiffness_s": 0.01, "numerical": 0},
           "fixed": [{"box_mm": [[0, 0, 0], [1, 100, 10]]}], "gravity_mm_per_s2": [0, 0, -9810]})"));
   EXPECT_EQ(s.mode, SimulationMode::dynamic);
   EXPECT_EQ(s.solver, SolverKind::cholmod);
@@ -61,6 +61,8 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(s.steps, 50);
   EXPECT_EQ(s.steps_per_frame, 5);
   EXPECT_EQ(s.frames_every, 2);
+  EXPECT_EQ(s.iterations_per_step, 4);
+  EXPECT_EQ(defaults.iterations_per_step, 0);
   EXPECT_EQ(s.mass_damping_per_s, 3.0);
   EXPECT_EQ(s.stiffness_damping_s, 0.01);
   EXPECT_EQ(s.numerical_damping, 0.0);
@@ -90,7 +92,9 @@ TEST(CaseMechanics, BadSimulationFieldsAreNamed) {
             "case.json: /simulation/fixed is \"left\"; expected \"none\", \"free\", {\"box_mm\": [[x0, y0, z0], [x1, y1, z1]]}, {\"surface\": \"inner\"} or an array of such");
   EXPECT_EQ(simulation_error(R"({"time_step": 0.1})"),
             "case.json: /simulation has unknown key 'time_step'; expected one of: mode, solver, tolerance, max_iterations, "
-            "time_step_s, steps, steps_per_frame, frames_every, damping, fixed, gravity_mm_per_s2");
+            "iterations_per_step, time_step_s, steps, steps_per_frame, frames_every, damping, fixed, gravity_mm_per_s2");
+  EXPECT_EQ(simulation_error(R"({"iterations_per_step": -2})"),
+            "case.json: /simulation/iterations_per_step is -2; expected an integer from 0 to 100000000");
 }
 
 TEST(CaseMechanics, BadMaterialsAreNamed) {

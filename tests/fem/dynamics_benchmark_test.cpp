@@ -7,9 +7,10 @@
 // CLEAVE_BENCH_STRESS_KPA (a uniform residual tension s_xx = s_yy in every cell, so that the step
 // carries the stress stiffness; default none), CLEAVE_BENCH_MATRIX_FREE (0: assemble the system
 // every step; default 1), CLEAVE_BENCH_CUT_STEPS (the first this many steps each follow a cut
-// that lengthens a slit through the tube's upper half by 2 cells: the step after a cut; default 0).
+// that lengthens a slit through the tube's upper half by 2 cells: the step after a cut; default 0),
+// CLEAVE_BENCH_ITERATIONS_PER_STEP (DynamicsSettings::iterations_per_step; default 0, no budget).
 // Prints per-step times, iterations, residuals (and the start's) and the largest displacement;
-// asserts only that every step converged.
+// asserts only that every step converged or used its budget.
 #include <gtest/gtest.h>
 
 #include <algorithm>
@@ -90,6 +91,8 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   const int steps = steps_text != nullptr ? std::atoi(steps_text) : 20;
   if (const char* tol = std::getenv("CLEAVE_BENCH_STEP_TOLERANCE"); tol != nullptr) settings.step_tolerance = std::atof(tol);
   settings.mass_damping_per_s = 2.0;
+  if (const char* budget = std::getenv("CLEAVE_BENCH_ITERATIONS_PER_STEP"); budget != nullptr)
+    settings.iterations_per_step = std::atoi(budget);
   settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
   const double z0 = volume.grid().origin_mm.z();
   for (VertexId v = 0; v < volume.vertex_count(); ++v) {
@@ -129,7 +132,7 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
                 i, ms.back(), cpu_ms, r.iterations, r.relative_residual, r.initial_relative_residual, cut_ms,
                 sim.displacement().lpNorm<Eigen::Infinity>());
     std::fflush(stdout);
-    EXPECT_TRUE(r.converged);
+    EXPECT_TRUE(r.converged || r.iterations == settings.iterations_per_step);
   }
   std::sort(ms.begin(), ms.end());
   std::sort(with_cut_ms.begin(), with_cut_ms.end());

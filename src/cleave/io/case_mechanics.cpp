@@ -80,8 +80,8 @@ SimulationSettings parse_simulation_settings(const CaseFile& case_file) {
   if (!section) return s;
   const JsonPath at = case_file.at("simulation");
   json_allow_keys(*section, at,
-                  {"mode", "solver", "tolerance", "max_iterations", "time_step_s", "steps", "steps_per_frame",
-                   "frames_every", "damping", "fixed", "gravity_mm_per_s2"});
+                  {"mode", "solver", "tolerance", "max_iterations", "iterations_per_step", "time_step_s", "steps",
+                   "steps_per_frame", "frames_every", "damping", "fixed", "gravity_mm_per_s2"});
   if (const auto* v = json_find(*section, "mode")) s.mode = parse_mode(*v, at / "mode");
   if (const auto* v = json_find(*section, "solver")) s.solver = parse_solver(*v, at / "solver");
   if (const auto* v = json_find(*section, "tolerance"))
@@ -89,6 +89,8 @@ SimulationSettings parse_simulation_settings(const CaseFile& case_file) {
                                                 "a relative residual tolerance in (0, 1)");
   if (const auto* v = json_find(*section, "max_iterations"))
     s.solve.max_iterations = json_int_in(*v, at / "max_iterations", 1, kMaxIterations);
+  if (const auto* v = json_find(*section, "iterations_per_step"))
+    s.iterations_per_step = json_int_in(*v, at / "iterations_per_step", 0, kMaxIterations);
   if (const auto* v = json_find(*section, "time_step_s"))
     s.time_step_s = json_number_in(*v, at / "time_step_s", kSmallest, kInf, "a positive time step in s");
   if (const auto* v = json_find(*section, "steps")) s.steps = json_int_in(*v, at / "steps", 1, kMaxSteps);

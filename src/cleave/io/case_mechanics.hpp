@@ -49,6 +49,7 @@ struct SimulationSettings {
   int steps = 100;
   int steps_per_frame = 10;
   int frames_every = 1;
+  int iterations_per_step = 0;  ///< dynamic: the real-time budget (DynamicsSettings::iterations_per_step); 0 = none
   double mass_damping_per_s = 0;
   double stiffness_damping_s = 0;
   double numerical_damping = 0.2;  ///< HHT -alpha (fem/dynamics.hpp)

@@ -80,6 +80,7 @@ void stage_mechanics(RunContext& ctx) {
     DynamicsSettings ds;
     ds.solver = settings.solver;
     ds.solve = settings.solve;
+    ds.iterations_per_step = settings.iterations_per_step;
     ds.mass_damping_per_s = settings.mass_damping_per_s;
     ds.stiffness_damping_s = settings.stiffness_damping_s;
     ds.numerical_damping = settings.numerical_damping;

@@ -3,6 +3,8 @@
 #include <fmt/format.h>
 
 #include <algorithm>
+#include <cmath>
+#include <limits>
 
 #include "cleave/core/error.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
@@ -288,9 +290,16 @@ class MultigridCgSolver final : public LinearSolver {
 
   /// Remembers the first solve's iterations after a build; a solve far above them asks for a
   /// rebuild at the next update.
+  /// A solve stopped by an iteration budget counts the iterations it would have needed at its rate.
   SolveReport track(const SolveReport& report) {
-    if (baseline_iterations_ < 0) baseline_iterations_ = report.iterations;
-    else if (report.iterations > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
+    double needed = report.iterations;
+    if (!report.converged && report.initial_relative_residual > 0) {
+      const double target = settings_.initial_residual_tolerance > 0 ? settings_.initial_residual_tolerance
+                                                                      : settings_.relative_tolerance / report.initial_relative_residual;
+      if (target < 1) needed = iterations_at_reached_rate(report, target);
+    }
+    if (baseline_iterations_ < 0) baseline_iterations_ = static_cast<int>(std::min(std::ceil(needed), 1e6));
+    else if (needed > options_.stale_iteration_growth * baseline_iterations_ + 2) rebuild_requested_ = true;
     return report;
   }
 
@@ -308,6 +317,14 @@ class MultigridCgSolver final : public LinearSolver {
 };
 
 }  // namespace
+
+double iterations_at_reached_rate(const SolveReport& report, double target_reduction) {
+  if (report.converged || !(target_reduction > 0 && target_reduction < 1)) return report.iterations;
+  const double reached = report.initial_relative_residual > 0 ? report.relative_residual / report.initial_relative_residual : 1.0;
+  if (report.iterations <= 0 || !(reached < 1) || !std::isfinite(reached)) return std::numeric_limits<double>::infinity();
+  if (reached <= target_reduction) return report.iterations;
+  return report.iterations * std::log(target_reduction) / std::log(reached);
+}
 
 std::unique_ptr<LinearSolver> make_multigrid_cg_solver(const SolveSettings& settings, const MultigridOptions& options) {
   return std::make_unique<MultigridCgSolver>(settings, options);

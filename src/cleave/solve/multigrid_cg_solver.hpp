@@ -15,4 +15,12 @@ namespace cleave {
 
 std::unique_ptr<LinearSolver> make_multigrid_cg_solver(const SolveSettings& settings, const MultigridOptions& options = {});
 
+/// The iterations `report`'s solve would have needed to cut its initial residual by
+/// `target_reduction` (0 < target < 1) at the mean rate per iteration it reached: its own count when
+/// it converged; more when an iteration budget stopped it first (the dynamic step's
+/// DynamicsSettings::iterations_per_step); infinity when it reduced nothing. The multigrid's rule
+/// for rebuilding stale levels compares these, so that it still sees a budgeted step's levels
+/// grow stale.
+double iterations_at_reached_rate(const SolveReport& report, double target_reduction);
+
 }  // namespace cleave
