@@ -30,6 +30,7 @@ std::string_view stage_key(Stage stage) {
     case Stage::equilibrate: return "equilibrate";
     case Stage::preview: return "preview";
     case Stage::step: return "step";
+    case Stage::step_budget: return "step_budget";
     case Stage::update: return "update";
     case Stage::vector_drag: return "vector_drag";
     case Stage::update_drag: return "update_drag";
@@ -47,6 +48,7 @@ StageFigures& ImplementationFigures::stage(Stage s) {
     case Stage::equilibrate: return equilibrate;
     case Stage::preview: return preview;
     case Stage::step: return step;
+    case Stage::step_budget: return step_budget;
     case Stage::update: return update;
     case Stage::vector_drag: return vector_drag;
     case Stage::update_drag: return update_drag;

@@ -11,6 +11,10 @@
 //   equilibrate  making the designed stress exactly self-balanced
 //   preview      one incision-preview solve: statics of the body with round incisions cut
 //   step         one implicit corotational Newmark step during an ongoing cut
+//   step_budget  the same steps with cleave's real-time budget (kRealTimeIterationsPerStep
+//                multigrid CG iterations per step, as the studio's wound opening); its
+//                relative_difference is its final displacement against cleave's solved steps
+//                (peers: skipped, they solve every step)
 //   update       edit-to-picture: one stroke edit -> direction + eigenvalues + preview + surface;
 //                stroke 0 moves among three positions in turn (vector, value and equilibrate are
 //                timed in the same edits): each edit's cells were edited before, but its design
@@ -55,17 +59,18 @@ enum class Stage {
   equilibrate,
   preview,
   step,
+  step_budget,
   update,
   vector_drag,
   update_drag,
   update_final,
   update_drag_final
 };
-inline constexpr Stage kAllStages[] = {Stage::vector,      Stage::value,       Stage::value_point,  Stage::equilibrate,
-                                       Stage::preview,     Stage::step,        Stage::update,       Stage::vector_drag,
-                                       Stage::update_drag, Stage::update_final, Stage::update_drag_final};
-/// "vector", "value", "value_point", "equilibrate", "preview", "step", "update", "vector_drag", "update_drag",
-/// "update_final", "update_drag_final".
+inline constexpr Stage kAllStages[] = {Stage::vector,      Stage::value,        Stage::value_point,  Stage::equilibrate,
+                                       Stage::preview,     Stage::step,         Stage::step_budget,  Stage::update,
+                                       Stage::vector_drag, Stage::update_drag,  Stage::update_final, Stage::update_drag_final};
+/// "vector", "value", "value_point", "equilibrate", "preview", "step", "step_budget", "update", "vector_drag",
+/// "update_drag", "update_final", "update_drag_final".
 std::string_view stage_key(Stage stage);
 
 struct StageFigures {
@@ -79,8 +84,8 @@ struct StageFigures {
 struct ImplementationFigures {
   Implementation implementation = Implementation::cleave;
   std::string solver;  ///< the solver's own name as it reports it
-  StageFigures vector, value, value_point, equilibrate, preview, step, update, vector_drag, update_drag, update_final,
-      update_drag_final;
+  StageFigures vector, value, value_point, equilibrate, preview, step, step_budget, update, vector_drag, update_drag,
+      update_final, update_drag_final;
   double peak_mb = 0;  ///< peak resident memory while this implementation ran (MB = 1e6 bytes)
 
   StageFigures& stage(Stage s);

@@ -13,6 +13,7 @@
 
 #include "bench_models.hpp"
 #include "bench_scenario.hpp"
+#include "cleave/fem/dynamics.hpp"
 #include "cleave/core/address_sanitizer.hpp"
 #include "cleave/shapes/builtin_shapes.hpp"
 #include "implementation_setup.hpp"
@@ -34,6 +35,10 @@ constexpr double kFrameAgreementTolerance = 1e-3;
 // The step's accuracy against a 1e-12 solve is asserted over 100 steps in
 // tests/fem/dynamics_step_tolerance_test.cpp; here a real disagreement (a wrong system) is O(1).
 constexpr double kStepAgreementTolerance = 2e-2;
+// The budgeted steps (kRealTimeIterationsPerStep iterations each) against cleave's solved ones
+// after the same few steps; their accuracy over a whole opening is asserted in
+// tests/fem/dynamics_iteration_budget_test.cpp.
+constexpr double kStepBudgetAgreementTolerance = 5e-2;
 
 std::vector<nlohmann::json> run_quick_bench(const std::string& arguments = "--quick", const std::string& environment = "") {
   const std::string command = environment + std::string(CLEAVE_CLI_PATH) + " bench " + arguments + " --json --quiet";
@@ -92,6 +97,11 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
     ASSERT_TRUE(m["ms_step"].is_number());
     EXPECT_GT(m["iterations"]["step"].get<int>(), 0);
     EXPECT_GT(m["iterations"]["equilibrate"].get<int>(), 0);  // the stroke edits unbalance the design
+    // The real-time step: the same steps within the budget, close to the solved ones.
+    ASSERT_TRUE(m["ms_step_budget"].is_number());
+    EXPECT_GT(m["iterations"]["step_budget"].get<int>(), 0);
+    EXPECT_LE(m["iterations"]["step_budget"].get<int>(), kRealTimeIterationsPerStep);
+    EXPECT_LT(m["relative_difference"]["step_budget"].get<double>(), kStepBudgetAgreementTolerance);
     // The picture comes first; each edit's final design is the picture's edit plus its completion.
     ASSERT_TRUE(m["ms_update_final"].is_number());
     ASSERT_TRUE(m["ms_update_drag_final"].is_number());
@@ -112,6 +122,8 @@ TEST(BenchSmoke, QuickRunPrintsOneObjectPerModelAndPeersAgree) {
         EXPECT_LT(difference.get<double>(), tolerance);
       }
       EXPECT_TRUE(p["relative_difference"].contains("step"));
+      EXPECT_TRUE(p["ms_step_budget"].is_null());
+      EXPECT_EQ(p["skipped"]["step_budget"], "the real-time budget is cleave's; the peers solve every step");
       EXPECT_TRUE(p["relative_difference"].contains("preview"));
     }
   }

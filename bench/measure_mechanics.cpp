@@ -48,7 +48,7 @@ MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchS
 }
 
 MechanicsOutcome measure_dynamic_step(const TissueModel& uncut, const BenchScenario& scenario,
-                                      Implementation implementation, int repeat) {
+                                      Implementation implementation, int repeat, int iterations_per_step) {
   TissueModel model = uncut;
   const BodySurface surface(model);
   std::vector<CutPlan> segments;
@@ -62,6 +62,7 @@ MechanicsOutcome measure_dynamic_step(const TissueModel& uncut, const BenchScena
   settings.solver = scope.solver();
   settings.solve.parallel_substitution = scope.parallel_substitution();
   settings.mass_damping_per_s = kBenchMassDamping_per_s;
+  settings.iterations_per_step = iterations_per_step;
   Dynamics sim(model, scenario.residual_stress_kPa, settings);
   MechanicsOutcome out;
   std::vector<double> samples_ms;

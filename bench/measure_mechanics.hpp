@@ -8,7 +8,9 @@
 //                     before each step the next segment of the scalpel cut is applied and the
 //                     simulation told about it (not timed); the step itself is timed. Two warm-up
 //                     steps, then `repeat` timed steps; every implementation takes the same steps.
-//                     Its iterations are the largest count of the timed steps.
+//                     Its iterations are the largest count of the timed steps. With
+//                     `iterations_per_step` > 0 every step stops after that many iterations
+//                     (DynamicsSettings::iterations_per_step: the real-time budget).
 //
 // Each returns the stage's figures and its final displacement (3 n_v, mm) so peers can be
 // compared with cleave. ComputeError from a solver propagates.
@@ -35,6 +37,6 @@ MechanicsOutcome measure_incision_preview(const TissueModel& uncut, const BenchS
                                           Implementation implementation, int repeat);
 
 MechanicsOutcome measure_dynamic_step(const TissueModel& uncut, const BenchScenario& scenario,
-                                      Implementation implementation, int repeat);
+                                      Implementation implementation, int repeat, int iterations_per_step = 0);
 
 }  // namespace cleave::bench
