@@ -2,7 +2,7 @@
 // The studio's edit-to-result time as a client sees it, over the WebSocket of a running server:
 //
 //   build/release/bin/cleave studio abdomen --res 126x41x84 --session /tmp/s --port 8765 &
-//   node --experimental-websocket scripts/studio-timings.mjs ws://127.0.0.1:8765/ws [DRAGS] [SETTLE_S]
+//   node --experimental-websocket scripts/studio-timings.mjs ws://127.0.0.1:8765/ws [DRAGS] [SETTLE_S] [CUT_DEPTH_MM]
 //
 // On a bare session it designs what `cleave demo` designs on the abdomen (three strokes along x
 // over the skin at 20, 50 and 80 % of its length, four control points of 20 / 10 kPa), then moves
@@ -15,13 +15,17 @@
 // preview's factorization runs in the background for 15-30 s at 45k cells after the design, and
 // until it is ready the preview is solved by the multigrid (200-350 ms). The drags follow the
 // skin for about 12 cells; start each run on a fresh session.
+// CUT_DEPTH_MM (optional, > 0): after the drags, a scalpel cut of that depth across the middle of
+// the skin (along x, from 35 to 65 % of the width): it prints each streamed frame's arrival after
+// the one before it, the server's mean step time and the wound width, then the cut's result.
 import { decodeMessage } from '../web/js/packed.js';
 
 const url = process.argv[2];
 const drags = Number(process.argv[3] ?? 8);
 const settleS = Number(process.argv[4] ?? 30);
-if (!url || !(drags > 0) || !(settleS >= 0)) {
-  console.error('usage: studio-timings.mjs ws://127.0.0.1:PORT/ws [DRAGS] [SETTLE_S]');
+const cutDepthMm = process.argv[5] === undefined ? 0 : Number(process.argv[5]);
+if (!url || !(drags > 0) || !(settleS >= 0) || !(cutDepthMm >= 0)) {
+  console.error('usage: studio-timings.mjs ws://127.0.0.1:PORT/ws [DRAGS] [SETTLE_S] [CUT_DEPTH_MM]');
   process.exit(2);
 }
 
@@ -125,4 +129,32 @@ for (let k = 0; k < drags; k++) {
 }
 console.log(`median over ${rows.length} drags: ack ${median(rows.map((r) => r.ack_ms)).toFixed(0)} ms, result ${median(rows.map((r) => r.edit_ms)).toFixed(0)} ms, server total ` +
   `${median(rows.map((r) => r.server.total)).toFixed(0)} ms, provisional ${rows.filter((r) => r.provisional).length}`);
+
+if (cutDepthMm > 0) {
+  const path = [];
+  for (let i = 0; i <= 6; i++) path.push(skinPoint(latestResult, lo[0] + (0.35 + 0.05 * i) * w, lo[2] + 0.5 * l));
+  const sent = performance.now();
+  const ack = await request('add_cut', { kind: 'scalpel', depth_mm: cutDepthMm, path_mm: path });
+  const frames = [];
+  let last = sent;
+  const { m: result, at } = await new Promise((resolve, reject) => {
+    waiters.push({ test: (m) => {
+      if (m.type === 'frame') {
+        const now = performance.now();
+        frames.push({ index: m.index, after_ms: now - last, step_ms: m.step_ms, width_mm: m.width_mm });
+        last = now;
+      }
+      return m.type === 'result' && m.seq >= ack.seq;
+    }, resolve });
+    setTimeout(() => reject(new Error('the cut timed out')), 600000);
+  });
+  for (const f of frames)
+    console.log(`frame ${f.index}: ${f.after_ms.toFixed(0)} ms after the ${f.index ? 'frame before' : 'cut was sent'}, ` +
+      `mean step ${f.step_ms.toFixed(0)} ms, width ${(f.width_mm ?? NaN).toFixed(2)} mm`);
+  const later = frames.filter((f) => f.index > 1).map((f) => f.after_ms);
+  const t = result.timings_ms;
+  console.log(`cut: result after ${(at - sent).toFixed(0)} ms (server ${t.total.toFixed(0)}: opening ${(t.opening ?? 0).toFixed(0)}, ` +
+    `frame ${(t.frame ?? 0).toFixed(0)}, incisions ${(t.incisions ?? 0).toFixed(0)}); frames after the first step: median ` +
+    `${median(later).toFixed(0)} ms apart${result.cut_error ? `; cut error: ${result.cut_error}` : ''}`);
+}
 ws.close();
