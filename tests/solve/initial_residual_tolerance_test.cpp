@@ -142,5 +142,24 @@ TEST(ZeroStartWhenBetter, TheMultigridStartsFromZeroForAnOvershootingGuessAndSto
   EXPECT_GT((y - exact).norm(), 10.0 * (x - exact).norm());
 }
 
+// A solve stopped by its iteration budget (the dynamic step's iterations_per_step) reports the
+// CG recurrence's residual instead of computing the true one: it must be the true one to rounding.
+TEST(IterationBudget, AStopOutOfIterationsReportsTheTrueResidual) {
+  TissueModel model = test::make_box({40, 6, 6}, 1.0);  // a long cantilever: several iterations
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  for (const int budget : {1, 2, 3}) {
+    SolveSettings settings;
+    settings.max_iterations = budget;
+    auto solver = make_linear_solver(SolverKind::multigrid_cg, settings);
+    solver->setup(s.a, model.volume);
+    Vector x = Vector::Zero(s.b.size());
+    const SolveReport r = solver->solve(s.b, x);
+    const double truth = (s.b - s.a * x).norm() / s.b.norm();
+    EXPECT_FALSE(r.converged);
+    EXPECT_EQ(r.iterations, budget);
+    EXPECT_NEAR(r.relative_residual, truth, 1e-9 * truth) << budget << " iterations";
+  }
+}
+
 }  // namespace
 }  // namespace cleave

@@ -46,11 +46,11 @@ class IterationProduct<VertexOperator> {
 /// Plain PCG from x; `iterations` is increased by the iterations done. When `initial_norm` is not
 /// null it receives ||b - A x|| of the start (before any iteration); with `zero_when_better` the
 /// start is x = 0 instead when x is farther from the solution in the energy norm (see
-/// SolveSettings::zero_start_when_better).
+/// SolveSettings::zero_start_when_better). `recurrence_norm`: the recurrence's last ||r||.
 template <typename Matrix>
 CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner& preconditioner, IterationProduct<Matrix>& product,
                double& target, double initial_factor, double* initial_norm, bool zero_when_better, int max_iterations,
-               int& iterations) {
+               int& iterations, double& recurrence_norm) {
   const Eigen::Index n = a.rows();
   Vector r(n), z(n), p(n), q(n);
   residual(a, b, x, r);
@@ -64,7 +64,8 @@ CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner
     *initial_norm = r.norm();
     target = std::max(target, initial_factor * *initial_norm);
   }
-  if (r.norm() <= target) return CgStop::converged_recurrence;
+  recurrence_norm = r.norm();
+  if (recurrence_norm <= target) return CgStop::converged_recurrence;
   preconditioner.apply(r, z);
   p = z;
   double rz = r.dot(z);
@@ -77,6 +78,7 @@ CgStop run_pcg(const Matrix& a, const Vector& b, Vector& x, const Preconditioner
     r.noalias() -= alpha * q;
     ++iterations;
     const double r_norm = r.norm();
+    recurrence_norm = r_norm;
     if (!std::isfinite(r_norm)) return CgStop::breakdown;
     if (r_norm <= target) return CgStop::converged_recurrence;
     preconditioner.apply(r, z);
@@ -109,9 +111,17 @@ SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, c
   double r_norm = 0;
   IterationProduct<Matrix> product(settings);
   for (int restart = 0; restart <= kMaxRestarts; ++restart) {
+    double recurrence_norm = 0;
     const CgStop stop = run_pcg(a, b, x, preconditioner, product, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
-                                restart == 0 && settings.zero_start_when_better, settings.max_iterations, report.iterations);
+                                restart == 0 && settings.zero_start_when_better, settings.max_iterations, report.iterations,
+                                recurrence_norm);
     if (!x.allFinite()) x = start;
+    // Out of iterations (the dynamic step's budget: DynamicsSettings::iterations_per_step) nothing
+    // decides on the residual, which is reported only: the recurrence's, without a product.
+    if (stop == CgStop::out_of_iterations && x.allFinite() && std::isfinite(recurrence_norm) && recurrence_norm > target) {
+      r_norm = recurrence_norm;
+      break;
+    }
     residual(a, b, x, r);
     r_norm = r.norm();
     if (stop != CgStop::converged_recurrence || r_norm <= target) break;
