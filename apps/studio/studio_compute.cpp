@@ -288,7 +288,8 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     if (ctx.superseded()) return;
     report(ctx.progress, "opening the wound", 0.5 + 0.2 * i / kOpeningFrames);
     const auto ts = Clock::now();
-    if (i > 0) sim.step(kOpeningStep_s);
+    SolveReport step;
+    if (i > 0) step = sim.step(kOpeningStep_s);
     const std::vector<Vec3> u = sim.displacement_mm();
     const std::vector<Vec3> x = deformed_positions(surface, preview_model_->volume, u);
     nlohmann::json frame = {{"type", "frame"}, {"generation", generation}, {"index", i}, {"frames", kOpeningFrames},
@@ -306,6 +307,10 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     }
     if (i > 0) step_ms += ms_since(ts);
     frame["step_ms"] = i > 0 ? step_ms / i : 0.0;
+    // What the budget left of this step (kOpeningIterationsPerStep): its iterations and its
+    // residual over the one it started from.
+    frame["step_iterations"] = step.iterations;
+    if (step.initial_relative_residual > 0) frame["step_residual"] = step.relative_residual / step.initial_relative_residual;
     frame = checked_outgoing(std::move(frame));
     send_(wire_encoded(frame));
     if (frame["type"] == "error") return;  // the statics after it report the result (or its error)

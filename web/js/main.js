@@ -99,13 +99,15 @@ function onMessage(m) {
   } else if (m.type === 'frame') {
     // The wound opening, streamed step by step before the final result.
     app.frames++;
-    app.lastFrame = { index: m.index, time_s: m.time_s, width_mm: m.width_mm, step_ms: m.step_ms };
+    app.lastFrame = { index: m.index, time_s: m.time_s, width_mm: m.width_mm, step_ms: m.step_ms,
+      step_iterations: m.step_iterations, step_residual: m.step_residual };
     viewer.showFrame(m.positions_mm, m.triangles);
     const width = m.width_mm !== undefined ? `${m.width_mm.toFixed(2)} mm` : '–';
     $('wound-width').textContent = `${width} (t = ${(m.time_s * 1000).toFixed(0)} ms)`;
     $('progress').hidden = false;
     $('progress').querySelector('.fill').style.width = `${((100 * m.index) / m.frames).toFixed(0)}%`;
-    $('progress').querySelector('.text').textContent = `opening the wound: frame ${m.index}/${m.frames} · ${m.step_ms.toFixed(0)} ms per step`;
+    const budget = m.step_residual !== undefined ? ` (${m.step_iterations} iterations, residual ${m.step_residual.toExponential(0)} of the step's)` : '';
+    $('progress').querySelector('.text').textContent = `opening the wound: frame ${m.index}/${m.frames} · ${m.step_ms.toFixed(0)} ms per step${budget}`;
   } else if (m.type === 'progress') {
     app.progressCount++;
     app.lastProgress = m;
