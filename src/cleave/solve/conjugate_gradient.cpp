@@ -115,10 +115,11 @@ SolveReport preconditioned_cg_any(const Matrix& a, const Vector& b, Vector& x, c
     const CgStop stop = run_pcg(a, b, x, preconditioner, product, target, initial_factor, restart == 0 ? &initial_norm : nullptr,
                                 restart == 0 && settings.zero_start_when_better, settings.max_iterations, report.iterations,
                                 recurrence_norm);
-    if (!x.allFinite()) x = start;
+    const bool finite = x.allFinite();
+    if (!finite) x = start;
     // Out of iterations (the dynamic step's budget: DynamicsSettings::iterations_per_step) nothing
     // decides on the residual, which is reported only: the recurrence's, without a product.
-    if (stop == CgStop::out_of_iterations && x.allFinite() && std::isfinite(recurrence_norm) && recurrence_norm > target) {
+    if (stop == CgStop::out_of_iterations && finite && std::isfinite(recurrence_norm) && recurrence_norm > target) {
       r_norm = recurrence_norm;
       break;
     }

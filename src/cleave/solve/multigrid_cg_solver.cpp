@@ -294,8 +294,8 @@ class MultigridCgSolver final : public LinearSolver {
   SolveReport track(const SolveReport& report) {
     double needed = report.iterations;
     if (!report.converged && report.initial_relative_residual > 0) {
-      const double target = settings_.initial_residual_tolerance > 0 ? settings_.initial_residual_tolerance
-                                                                      : settings_.relative_tolerance / report.initial_relative_residual;
+      // CG's stopping rule relative to the start: the looser of its two tolerances.
+      const double target = std::max(settings_.initial_residual_tolerance, settings_.relative_tolerance / report.initial_relative_residual);
       if (target < 1) needed = iterations_at_reached_rate(report, target);
     }
     if (baseline_iterations_ < 0) baseline_iterations_ = static_cast<int>(std::min(std::ceil(needed), 1e6));
