@@ -36,7 +36,7 @@ function setMessage(text, isError = false) {
 /// surface this page never got (it connected in between) is skipped and the full latest result
 /// asked for (hello).
 const surfaceCache = { id: null, triangles: null, cutDepth: null };
-function withTriangles(m) {
+function withSurfaceParts(m) {
   const s = m.surface;
   if (s.triangles) {
     surfaceCache.id = s.id;
@@ -58,7 +58,7 @@ function onMessage(m) {
     app.state = m;
     refreshDesign();
   } else if (m.type === 'result') {
-    if (!withTriangles(m)) return;
+    if (!withSurfaceParts(m)) return;
     app.result = m;
     app.resultCount++;
     app.resultSeqs.push(m.seq);
