@@ -161,5 +161,42 @@ TEST(IterationBudget, AStopOutOfIterationsReportsTheTrueResidual) {
   }
 }
 
+/// M = identity, counting its applications.
+class CountingPreconditioner final : public Preconditioner {
+ public:
+  void apply(const Vector& r, Vector& z) const override {
+    z = r;
+    ++applications;
+  }
+  mutable int applications = 0;
+};
+
+// Each CG iteration needs one preconditioned residual for its direction, and the last iteration
+// of a solve none: a solve out of iterations stops without preconditioning a residual it will
+// not use (a whole V-cycle, a fifth of a dynamic step with a budget of 4), as a converged one does.
+TEST(IterationBudget, NoPreconditionerApplicationIsLeftUnused) {
+  TissueModel model = test::make_box({40, 6, 6}, 1.0);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  for (const int budget : {1, 2, 5}) {
+    SolveSettings settings;
+    settings.max_iterations = budget;
+    CountingPreconditioner counting;
+    Vector x = Vector::Zero(s.b.size());
+    const SolveReport r = preconditioned_cg(s.a, s.b, x, counting, settings);
+    EXPECT_FALSE(r.converged);
+    EXPECT_EQ(r.iterations, budget);
+    EXPECT_EQ(counting.applications, budget) << budget << " iterations";
+    EXPECT_NEAR(r.relative_residual, (s.b - s.a * x).norm() / s.b.norm(), 1e-9 * r.relative_residual);
+  }
+  // A converged solve: as many applications as iterations, too.
+  SolveSettings settings;
+  settings.relative_tolerance = 1e-6;
+  CountingPreconditioner counting;
+  Vector x = Vector::Zero(s.b.size());
+  const SolveReport r = preconditioned_cg(s.a, s.b, x, counting, settings);
+  ASSERT_TRUE(r.converged);
+  EXPECT_EQ(counting.applications, r.iterations);
+}
+
 }  // namespace
 }  // namespace cleave

@@ -11,6 +11,7 @@
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
 #include "cleave/solve/grid_level.hpp"
+#include "cleave/solve/parallel_cast.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/coarsest_factor.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
@@ -395,9 +396,9 @@ void MultigridPreconditioner::smooth_around_coarse_correction(std::size_t l, con
 
 void MultigridPreconditioner::apply(const Vector& r, Vector& z) const {
   if (precision_ == CyclePrecision::single_precision) {
-    levels_[0].single.rhs = r.cast<float>();
+    cast_in_parallel(r, levels_[0].single.rhs);
     cycle<float>(0);
-    z = levels_[0].single.solution.cast<double>();
+    cast_in_parallel(levels_[0].single.solution, z);
   } else {
     levels_[0].twin.rhs = r;
     cycle<double>(0);
