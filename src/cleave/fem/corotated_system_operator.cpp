@@ -29,6 +29,15 @@ Eigen::Matrix<Scalar, 8, 8> stress_stiffness_of(const Eigen::Matrix<Scalar, 6, 1
   return s;
 }
 
+/// R s for the corner's outward signs s (+-1 per axis): the columns of R added or subtracted.
+Vec3 corner_sign_sum(const Mat3& rotation, int corner) {
+  const Vec3i o = corner_offset(corner);
+  Vec3 sum = o[0] != 0 ? Vec3(rotation.col(0)) : Vec3(-rotation.col(0));
+  sum += o[1] != 0 ? Vec3(rotation.col(1)) : Vec3(-rotation.col(1));
+  sum += o[2] != 0 ? Vec3(rotation.col(2)) : Vec3(-rotation.col(2));
+  return sum;
+}
+
 }  // namespace
 
 bool avx512_cell_pass_supported() {
@@ -86,7 +95,10 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
             single_.stiffness_by_component[m][static_cast<std::size_t>(3 * i + j)](a, b) = static_cast<float>(k);
           }
   }
+  split_corner_diagonals();
   for (std::size_t k = 0; k < 6; ++k) {
+    for (int a = 0; a < kCornerCount; ++a)
+      stress_diagonal_basis_[static_cast<std::size_t>(a)][static_cast<Eigen::Index>(k)] = table_->stress_stiffness[k](a, a);
     twin_.stress_basis[k] = table_->stress_stiffness[k];
     single_.stress_basis[k] = table_->stress_stiffness[k].cast<float>();
   }
@@ -249,21 +261,53 @@ double CorotatedSystemOperator::stress_coefficient(std::size_t cell, int a, int 
   return s;
 }
 
+void CorotatedSystemOperator::split_corner_diagonals() {
+  const std::size_t materials = twin_.stiffness.size();
+  corner_diagonal_.assign(materials, {});
+  for (std::size_t m = 0; m < materials; ++m)
+    for (int a = 0; a < kCornerCount; ++a) {
+      const Mat3 block = twin_.stiffness[m].block<3, 3>(3 * a, 3 * a);
+      const Vec3 sign = 2.0 * corner_offset(a).cast<double>() - Vec3::Ones();
+      const double along = block(0, 1) * sign[0] * sign[1];
+      const double isotropic = block(0, 0) - along;
+      const Mat3 split = isotropic * Mat3::Identity() + along * sign * sign.transpose();
+      if ((split - block).cwiseAbs().maxCoeff() > 1e-13 * block.cwiseAbs().maxCoeff()) {
+        corner_diagonal_.clear();
+        return;
+      }
+      corner_diagonal_[m][static_cast<std::size_t>(a)] = {isotropic, along};
+    }
+}
+
 std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
   const auto vertices = static_cast<std::size_t>(corner_slots_.start.size() - 1);
+  const bool split = !corner_diagonal_.empty();
   std::vector<Mat3> out(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, static_cast<std::size_t>(kVerticesPerTask)),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t v = r.begin(); v < r.end(); ++v) {
                         Mat3 block = Mat3::Zero();
+                        double stress_sum = 0;     // the stress stiffness's part: a multiple of I_3
+                        double isotropic_sum = 0;  // the split blocks' isotropic part (R I R^T = I)
                         for (std::int32_t s = corner_slots_.start[v]; s < corner_slots_.start[v + 1]; ++s) {
                           const auto slot = corner_slots_.slot[static_cast<std::size_t>(s)];
                           const auto c = static_cast<std::size_t>(slot / 24);
                           const int a = slot % 24;
                           const Mat3& rotation = rotations_[c];
-                          block.noalias() += rotation * twin_.stiffness[material_[c]].block<3, 3>(3 * a, 3 * a) * rotation.transpose();
-                          if (with_tension_) block.diagonal().array() += stress_coefficient(c, a, a);
+                          if (split) {  // R R^T = I: the rotations are polar factors
+                            const CornerDiagonal& d = corner_diagonal_[material_[c]][static_cast<std::size_t>(a)];
+                            const Vec3 turned = corner_sign_sum(rotation, a);
+                            isotropic_sum += d.isotropic;
+                            const Vec3 scaled = d.along_sign * turned;
+                            for (int i = 0; i < 3; ++i)
+                              for (int j = 0; j <= i; ++j) block(i, j) += scaled[i] * turned[j];
+                          } else {
+                            block.noalias() += rotation * twin_.stiffness[material_[c]].block<3, 3>(3 * a, 3 * a) * rotation.transpose();
+                          }
+                          if (with_tension_) stress_sum += twin_.tension[c].dot(stress_diagonal_basis_[static_cast<std::size_t>(a)]);
                         }
+                        if (split) block.triangularView<Eigen::StrictlyUpper>() = block.transpose();
+                        block.diagonal().array() += stress_sum + isotropic_sum;
                         const auto i = 3 * static_cast<Eigen::Index>(v);
                         block.diagonal() += twin_.mass_term.segment<3>(i);
                         if (!fixed_rows_.empty())
