@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cleave/fem/assemble_stiffness.hpp"
+#include "cleave/fem/hex8_element.hpp"
 #include "cleave/fem/residual_stress_forces.hpp"
 #include "cleave/fem/solve_static.hpp"
 #include "fem_test_models.hpp"
@@ -83,6 +84,27 @@ TEST(PatchTest, UniformStressGivesZeroInsideAndSurfaceTractionOnTheBoundary) {
   model.volume.cut_links(test::faces_between(model.volume, left));
   ASSERT_EQ(model.volume.component_count(), 2);
   EXPECT_EQ(check("cut"), 2 * (1 * 2 * 2));
+}
+
+// The deformation gradient at a cell's centre (what the corotation turns by) is exact for an
+// affine displacement, and equals I + sum_a u_a (grad N_a)^T from the shape functions for any.
+TEST(PatchTest, CentreDeformationGradientOfAnAffineAndOfAnyDisplacement) {
+  const double h_mm = 2.5;
+  Mat3 g;
+  g << 0.01, -0.2, 0.03, 0.15, -0.02, 0.4, -0.05, 0.07, 0.11;
+  const Vec3 shift(1.0, -2.0, 0.5);
+  Vec24 affine, any;
+  Eigen::Matrix<double, 8, 3> gradients;  // dN_a/dx at the centre
+  for (int a = 0; a < 8; ++a) {
+    const Vec3 corner = h_mm * Vec3((a & 1) ? 1.0 : 0.0, ((a >> 1) & 1) ? 1.0 : 0.0, ((a >> 2) & 1) ? 1.0 : 0.0);
+    affine.segment<3>(3 * a) = g * corner + shift;
+    for (int i = 0; i < 3; ++i) any[3 * a + i] = std::sin(1.7 * a + 0.9 * i);
+    for (int j = 0; j < 3; ++j) gradients(a, j) = (((a >> j) & 1) ? 1.0 : -1.0) / (4.0 * h_mm);
+  }
+  EXPECT_LE((hex8_center_deformation_gradient(affine, h_mm) - (Mat3::Identity() + g)).norm(), 1e-14);
+  Mat3 expected = Mat3::Identity();
+  for (int a = 0; a < 8; ++a) expected += any.segment<3>(3 * a) * gradients.row(a);
+  EXPECT_LE((hex8_center_deformation_gradient(any, h_mm) - expected).norm(), 1e-14);
 }
 
 }  // namespace

@@ -118,11 +118,19 @@ Mat24 hex8_consistent_mass(double h_mm, double density_kg_per_mm3) {
 }
 
 Mat3 hex8_center_deformation_gradient(const Vec24& u, double h_mm) {
-  // Every step takes it for every cell: the centre's local gradients (+-1/4) are formed once.
-  static const Eigen::Matrix<double, 8, 3> centre = shape_gradients_local(Vec3::Constant(0.5));
-  const Eigen::Matrix<double, 8, 3> g = centre / h_mm;
-  Mat3 f = Mat3::Identity();
-  for (int a = 0; a < 8; ++a) f += u.segment<3>(3 * a) * g.row(a);
+  // At the centre dN_a/dx_j = s_j / (4 h), s the corner's outward signs (+-1): column j of
+  // F - I is the sum of u over the corners on the far side of axis j minus those on the near side.
+  // Every step takes it for every cell: sums and differences, no products.
+  Mat3 f = Mat3::Zero();
+  for (int a = 0; a < 8; ++a) {
+    const Vec3 ua = u.segment<3>(3 * a);
+    for (int j = 0; j < 3; ++j) {
+      if (((a >> j) & 1) != 0) f.col(j) += ua;
+      else f.col(j) -= ua;
+    }
+  }
+  f *= 0.25 / h_mm;
+  f.diagonal().array() += 1.0;
   return f;
 }
 
