@@ -61,7 +61,8 @@ function waitFor(test, timeoutMs = 600000) {
   return new Promise((resolve, reject) => {
     const w = { test, resolve };
     waiters.push(w);
-    setTimeout(() => { const i = waiters.indexOf(w); if (i >= 0) { waiters.splice(i, 1); reject(new Error('timed out')); } }, timeoutMs);
+    // unref: a pending timeout does not keep the script alive once the socket is closed.
+    setTimeout(() => { const i = waiters.indexOf(w); if (i >= 0) { waiters.splice(i, 1); reject(new Error('timed out')); } }, timeoutMs).unref();
   });
 }
 
@@ -146,7 +147,7 @@ if (cutDepthMm > 0) {
       }
       return m.type === 'result' && m.seq >= ack.seq;
     }, resolve });
-    setTimeout(() => reject(new Error('the cut timed out')), 600000);
+    setTimeout(() => reject(new Error('the cut timed out')), 600000).unref();
   });
   for (const f of frames)
     console.log(`frame ${f.index}: ${f.after_ms.toFixed(0)} ms after the ${f.index ? 'frame before' : 'cut was sent'}, ` +
