@@ -152,6 +152,43 @@ TEST(CorotatedSystemOperator, BlockDiagonalAndAssemblyEqualTheAssembledSystem) {
   EXPECT_EQ(assembled.nonZeros(), a.nonZeros());  // the vertex block pattern of the cut body
 }
 
+// The smoother's step z = D^-1 (b - A x) in one pass with the product's per-vertex sum equals it
+// from the assembled matrix, fixed dofs (identity rows) included, in double and in float.
+TEST(CorotatedSystemOperator, JacobiResidualInOnePassEqualsItFromTheAssembledSystem) {
+  const Fixture f;
+  const SparseMatrix a = f.assembled();
+  const CorotatedSystemOperator op = f.op();
+  const std::vector<Mat3> inverse = op.inverse_diagonal_blocks();
+  const Vector x = probe(a.rows());
+  const Vector b = 0.5 * probe(a.rows()).reverse();
+  const Vector r = b - a * x;
+  Vector expected(a.rows());
+  for (std::size_t v = 0; v < inverse.size(); ++v) {
+    const auto i = 3 * static_cast<Eigen::Index>(v);
+    expected.segment<3>(i) = inverse[v] * r.segment<3>(i);
+  }
+  const double scale = expected.lpNorm<Eigen::Infinity>();
+  Vector z;
+  op.jacobi_residual(inverse, b, x, z);
+  EXPECT_LE((z - expected).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+  std::vector<Mat3f> single(inverse.size());
+  for (std::size_t v = 0; v < inverse.size(); ++v) single[v] = inverse[v].cast<float>();
+  Eigen::VectorXf z_single;
+  op.jacobi_residual(single, Eigen::VectorXf(b.cast<float>()), Eigen::VectorXf(x.cast<float>()), z_single);
+  // Float rounding of the product (values of order 1e5, as in the float product's test) and of D^-1.
+  Eigen::VectorXf z_default;
+  op.VertexOperator::jacobi_residual(single, Eigen::VectorXf(b.cast<float>()), Eigen::VectorXf(x.cast<float>()), z_default);
+  EXPECT_LE((z_single - z_default).lpNorm<Eigen::Infinity>(), 1e-6f * static_cast<float>(scale));
+  EXPECT_LE((z_single.cast<double>() - expected).lpNorm<Eigen::Infinity>(), 1e-4 * scale);
+  // Sizes that do not fit are refused with both named.
+  try {
+    op.jacobi_residual(inverse, Vector(Vector::Zero(6)), x, z);
+    ADD_FAILURE() << "a short right-hand side was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("right-hand side of 6 entries"), std::string::npos) << e.what();
+  }
+}
+
 TEST(CorotatedSystemOperator, WithoutTensionItIsTheCorotatedStiffnessPlusMass) {
   const Fixture f;
   CorotatedSystemOperator op;

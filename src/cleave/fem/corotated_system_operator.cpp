@@ -131,9 +131,9 @@ const Mat3& CorotatedSystemOperator::rotation_of<double>(const Precision<double>
   return rotations_[cell];
 }
 
-template <typename Scalar>
+template <typename Scalar, typename Finish>
 void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
-                                    Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const {
+                                    const Finish& finish) const {
   using Mat3S = Eigen::Matrix<Scalar, 3, 3>;
   if (rotations_.empty() && !material_.empty()) throw InputError("corotated system: set_state must come before a product");
   if (x_in.size() != rows())
@@ -163,7 +163,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       in.per_cell = p.per_cell.data();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
                         [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
-      sum_per_vertex(p, x_in, *x, y);
+      sum_per_vertex(p, x_in, *x, finish);
       return;
     }
   } else if (wide_cell_pass_ && cells > 0) {
@@ -180,7 +180,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
     in.per_cell = p.per_cell.data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
                       [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
-    sum_per_vertex(p, x_in, *x, y);
+    sum_per_vertex(p, x_in, *x, finish);
     return;
   }
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
@@ -222,15 +222,14 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
         Eigen::Map<Corners<Scalar>>(out + 8 * i) = rotation(i, 0) * f[0] + rotation(i, 1) * f[1] + rotation(i, 2) * f[2];
     }
   });
-  sum_per_vertex(p, x_in, *x, y);
+  sum_per_vertex(p, x_in, *x, finish);
 }
 
-template <typename Scalar>
+template <typename Scalar, typename Finish>
 void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
-                                             const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked,
-                                             Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const {
-  y.resize(x_in.size());
+                                             const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, const Finish& finish) const {
   const auto vertices = static_cast<VertexId>(corner_slots_.start.size() - 1);
+  const bool any_fixed = !fixed_rows_.empty();
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<VertexId>& r) {
     for (VertexId v = r.begin(); v < r.end(); ++v) {
       const auto i = 3 * static_cast<Eigen::Index>(v);
@@ -239,20 +238,54 @@ void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const E
         const Scalar* slot = p.per_cell.data() + corner_slots_.slot[static_cast<std::size_t>(s)];
         sum += Eigen::Matrix<Scalar, 3, 1>(slot[0], slot[8], slot[16]);
       }
-      y.template segment<3>(i) = sum;
+      if (any_fixed)
+        for (int axis = 0; axis < 3; ++axis)
+          if ((*fixed_)[static_cast<std::size_t>(i + axis)] != 0) sum[axis] = x_in[i + axis];  // identity rows
+      finish(v, sum);
     }
   });
-  for (const Eigen::Index i : fixed_rows_) y[i] = x_in[i];  // identity rows
 }
 
-void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const { apply(single_, x, y); }
+template <typename Scalar>
+void CorotatedSystemOperator::fused_jacobi_residual(const Precision<Scalar>& p,
+                                                    const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                                                    const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                                    const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                                                    Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) const {
+  if (b.size() != rows() || static_cast<Eigen::Index>(3 * inverse_diagonal.size()) != rows())
+    throw InputError(fmt::format("corotated system: right-hand side of {} entries and {} diagonal blocks; expected {} and {}", b.size(),
+                                 inverse_diagonal.size(), rows(), rows() / 3));
+  z.resize(rows());
+  apply(p, x, [&](VertexId v, const Eigen::Matrix<Scalar, 3, 1>& ax) {
+    const auto i = 3 * static_cast<Eigen::Index>(v);
+    z.template segment<3>(i) = inverse_diagonal[static_cast<std::size_t>(v)] * (b.template segment<3>(i) - ax);
+  });
+}
+
+void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const {
+  y.resize(rows());
+  apply(single_, x, [&](VertexId v, const Eigen::Vector3f& sum) { y.segment<3>(3 * static_cast<Eigen::Index>(v)) = sum; });
+}
+
+void CorotatedSystemOperator::jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b,
+                                              const Eigen::VectorXf& x, Eigen::VectorXf& z) const {
+  fused_jacobi_residual(single_, inverse_diagonal, b, x, z);
+}
+
+void CorotatedSystemOperator::jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b,
+                                              const Eigen::VectorXd& x, Eigen::VectorXd& z) const {
+  fused_jacobi_residual(twin_, inverse_diagonal, b, x, z);
+}
 
 void CorotatedSystemOperator::set_wide_cell_pass(bool on) {
   if (on && !avx512_cell_pass_supported())
     throw InputError("corotated system: the AVX-512 cell pass needs a CPU with AVX-512 F and DQ; this one has not");
   wide_cell_pass_ = on;
 }
-void CorotatedSystemOperator::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const { apply(twin_, x, y); }
+void CorotatedSystemOperator::multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const {
+  y.resize(rows());
+  apply(twin_, x, [&](VertexId v, const Eigen::Vector3d& sum) { y.segment<3>(3 * static_cast<Eigen::Index>(v)) = sum; });
+}
 
 double CorotatedSystemOperator::stress_coefficient(std::size_t cell, int a, int b) const {
   if (!with_tension_) return 0;

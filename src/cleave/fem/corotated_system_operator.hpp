@@ -50,6 +50,11 @@ class CorotatedSystemOperator final : public VertexOperator {
   Eigen::Index rows() const override { return 3 * static_cast<Eigen::Index>(corner_slots_.start.size() - 1); }
   void multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const override;
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
+  /// In one pass with the product's per-vertex sum (the product's values never stored).
+  void jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, const Eigen::VectorXf& x,
+                       Eigen::VectorXf& z) const override;
+  void jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+                       Eigen::VectorXd& z) const override;
   std::vector<Mat3> inverse_diagonal_blocks() const override;
   SparseMatrix assembled_matrix() const override;
   const std::vector<std::uint8_t>& fixed_dofs() const override { return *fixed_; }
@@ -86,14 +91,18 @@ class CorotatedSystemOperator final : public VertexOperator {
     mutable Eigen::Matrix<Scalar, Eigen::Dynamic, 1> masked;  ///< x with fixed dofs zeroed
     mutable std::vector<Scalar> per_cell;                     ///< 24 per cell: 8 x, 8 y, 8 z
   };
-  template <typename Scalar>
-  void apply(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
-             Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const;
-  /// y = the per-cell values summed per vertex plus the mass term (x_masked: x with fixed dofs
-  /// zero), identity rows for fixed dofs.
-  template <typename Scalar>
+  /// The product's cell pass on x, then per vertex finish(v, (A x)_v).
+  template <typename Scalar, typename Finish>
+  void apply(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, const Finish& finish) const;
+  /// Per vertex v: finish(v, sum) with sum the per-cell values summed at v plus the mass term
+  /// (x_masked: x with fixed dofs zero), x_in's value on fixed dofs (identity rows).
+  template <typename Scalar, typename Finish>
   void sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
-                      const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& y) const;
+                      const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, const Finish& finish) const;
+  template <typename Scalar>
+  void fused_jacobi_residual(const Precision<Scalar>& p, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                             const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                             Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) const;
   template <typename Scalar>
   const Eigen::Matrix<Scalar, 3, 3>& rotation_of(const Precision<Scalar>& p, std::size_t cell) const;
   /// The coefficient of I_3 in block (a, b) of cell c's stress stiffness, times c_stress.

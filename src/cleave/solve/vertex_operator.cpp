@@ -20,10 +20,12 @@ void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynami
   });
 }
 
+namespace {
+
 template <typename Scalar>
-void jacobi_residual(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
-                     const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
-                     Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) {
+void product_then_jacobi(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                         const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                         Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) {
   a.multiply(x, z);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, inverse_diagonal.size(), kVerticesPerTask),
                     [&](const tbb::blocked_range<std::size_t>& range) {
@@ -33,6 +35,25 @@ void jacobi_residual(const VertexOperator& a, const std::vector<Eigen::Matrix<Sc
                         z.template segment<3>(i) = inverse_diagonal[v] * r;
                       }
                     });
+}
+
+}  // namespace
+
+void VertexOperator::jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, const Eigen::VectorXf& x,
+                                     Eigen::VectorXf& z) const {
+  product_then_jacobi(*this, inverse_diagonal, b, x, z);
+}
+
+void VertexOperator::jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
+                                     Eigen::VectorXd& z) const {
+  product_then_jacobi(*this, inverse_diagonal, b, x, z);
+}
+
+template <typename Scalar>
+void jacobi_residual(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                     const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                     Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) {
+  a.jacobi_residual(inverse_diagonal, b, x, z);
 }
 
 template void residual<float>(const VertexOperator&, const Eigen::VectorXf&, const Eigen::VectorXf&, Eigen::VectorXf&);
