@@ -52,7 +52,7 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(defaults.numerical_damping, 0.2);
   const SimulationSettings s = parse_simulation_settings(case_from(
       R"(, "simulation": {"mode": "dynamic", "solver": "cholmod", "tolerance": 1e-9, "time_step_s": 0.002, "steps": 50,
-          "steps_per_frame": 5, "frames_every": 2, "iterations_per_step": 4, "damping": {"mass_per_s": 3, "stiffness_s": 0.01, "numerical": 0},
+          "steps_per_frame": 5, "frames_every": 2, "iterations_per_step": 4, "damping": {"mass_per_s": 3, "stiffness_s": 0.01, "numerical": 0, "high_frequency_radius": 0.25},
           "fixed": [{"box_mm": [[0, 0, 0], [1, 100, 10]]}], "gravity_mm_per_s2": [0, 0, -9810]})"));
   EXPECT_EQ(s.mode, SimulationMode::dynamic);
   EXPECT_EQ(s.solver, SolverKind::cholmod);
@@ -66,6 +66,8 @@ TEST(CaseMechanics, SimulationSettingsAreReadWithDefaults) {
   EXPECT_EQ(s.mass_damping_per_s, 3.0);
   EXPECT_EQ(s.stiffness_damping_s, 0.01);
   EXPECT_EQ(s.numerical_damping, 0.0);
+  EXPECT_EQ(s.high_frequency_radius, 0.25);
+  EXPECT_FALSE(defaults.high_frequency_radius.has_value());  // HHT unless asked
   ASSERT_EQ(s.fixed_boxes.size(), 1u);
   EXPECT_EQ(s.fixed_boxes[0].hi_mm, Vec3(1, 100, 10));
   EXPECT_EQ(s.gravity_mm_per_s2, Vec3(0, 0, -9810));
@@ -95,6 +97,8 @@ TEST(CaseMechanics, BadSimulationFieldsAreNamed) {
             "iterations_per_step, time_step_s, steps, steps_per_frame, frames_every, damping, fixed, gravity_mm_per_s2");
   EXPECT_EQ(simulation_error(R"({"iterations_per_step": -2})"),
             "case.json: /simulation/iterations_per_step is -2; expected an integer from 0 to 100000000");
+  EXPECT_EQ(simulation_error(R"({"damping": {"high_frequency_radius": 1.5}})"),
+            "case.json: /simulation/damping/high_frequency_radius is 1.5; expected a spectral radius from 0 to 1 (generalized-alpha)");
 }
 
 TEST(CaseMechanics, BadMaterialsAreNamed) {

@@ -38,6 +38,9 @@ Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_k
                                  settings_.mass_damping_per_s, settings_.stiffness_damping_s));
   if (!(settings_.numerical_damping >= 0 && settings_.numerical_damping <= 1.0 / 3.0))
     throw InputError(fmt::format("numerical damping is {}; expected a number from 0 to 1/3", settings_.numerical_damping));
+  if (settings_.high_frequency_radius && !(*settings_.high_frequency_radius >= 0 && *settings_.high_frequency_radius <= 1))
+    throw InputError(fmt::format("high-frequency spectral radius is {}; expected a number from 0 to 1 (generalized-alpha)",
+                                 *settings_.high_frequency_radius));
   const auto dofs = 3 * static_cast<Eigen::Index>(volume.vertex_count());
   if (settings_.external_force_mN.size() != 0 && settings_.external_force_mN.size() != dofs)
     throw InputError(fmt::format("external force holds {} values; expected {} (3 per vertex)", settings_.external_force_mN.size(), dofs));
@@ -324,8 +327,18 @@ double Dynamics::elastic_energy_uJ() const {
 
 SolveReport Dynamics::step(double dt) {
   if (!(dt > 0) || !std::isfinite(dt)) throw InputError(fmt::format("time step is {} s; expected a positive time step in s", dt));
-  const double gamma = kNewmarkGamma + settings_.numerical_damping;  // HHT with alpha = -numerical_damping
-  const double beta = 0.25 * (1.0 + settings_.numerical_damping) * (1.0 + settings_.numerical_damping);
+  // The inertia at n + 1 - alpha_inertia, the damping and elastic forces at n + 1 - alpha_forces:
+  // HHT (alpha_inertia = 0, alpha_forces = numerical_damping) or generalized-alpha with the
+  // high-frequency radius r (Chung & Hulbert 1993).
+  double alpha_inertia = 0.0;
+  double alpha_forces = settings_.numerical_damping;
+  if (settings_.high_frequency_radius) {
+    const double r = *settings_.high_frequency_radius;
+    alpha_inertia = (2.0 * r - 1.0) / (r + 1.0);
+    alpha_forces = r / (r + 1.0);
+  }
+  const double gamma = kNewmarkGamma - alpha_inertia + alpha_forces;
+  const double beta = 0.25 * (1.0 - alpha_inertia + alpha_forces) * (1.0 - alpha_inertia + alpha_forces);
   const double alpha_m = settings_.mass_damping_per_s;
   const double beta_k = settings_.stiffness_damping_s;
 
@@ -336,11 +349,12 @@ SolveReport Dynamics::step(double dt) {
     cell_rotations_and_tension(model_.volume, table_, stress_kPa_, u_, rotations_, tension_kPa_);
   else
     update_rotations();
-  // HHT: M a(n+1) + w [D v(n+1) + f_int(n+1)] + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - a,
+  // M [(1 - alpha_inertia) a(n+1) + alpha_inertia a(n)] + w [D v(n+1) + f_int(n+1)]
+  //   + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - alpha_forces,
   // with f_int(n+1) ~ f_int(n) + (K_R + K_sigma) du (R frozen over the step; K_sigma: how the
   // stress forces turn with the cells) and v(n+1) = gamma du / (beta dt) + damping_part.
-  const double w = 1.0 - settings_.numerical_damping;
-  const double c_mass = 1.0 / (beta * dt * dt) + w * alpha_m * gamma / (beta * dt);
+  const double w = 1.0 - alpha_forces;
+  const double c_mass = (1.0 - alpha_inertia) / (beta * dt * dt) + w * alpha_m * gamma / (beta * dt);
   const double c_stiff = w * (1.0 + beta_k * gamma / (beta * dt));
 
   // Velocity-like combinations of the old state that enter the increment equation: the damped
@@ -357,7 +371,7 @@ SolveReport Dynamics::step(double dt) {
   });
   // f_int + beta_k K_R v_damped in one pass over the cells.
   Vector rhs = internal_forces(&damped_velocity);
-  // rhs = f_ext - f_int + M inertia_part - alpha_m M v_damped; the Newmark predictor du, or no
+  // rhs = f_ext - f_int + M inertia - alpha_m M v_damped; the Newmark predictor du, or no
   // increment where that is closer (the solver's zero_start_when_better). Fixed dofs are held at
   // zero: their rows are identity rows with a zero right-hand side.
   Vector du(dofs);
@@ -370,8 +384,10 @@ SolveReport Dynamics::step(double dt) {
         du[i] = 0.0;
         continue;
       }
+      // M [(1 - alpha_inertia) a(n+1) + alpha_inertia a(n)], a(n+1) = du / (beta dt^2) - inertia_part.
       const double inertia_part = v_[i] / (beta * dt) + (0.5 / beta - 1.0) * a_[i];
-      double value = mass_[i] * (inertia_part - alpha_m * damped_velocity[i]) - rhs[i];
+      const double inertia = (1.0 - alpha_inertia) * inertia_part - alpha_inertia * a_[i];
+      double value = mass_[i] * (inertia - alpha_m * damped_velocity[i]) - rhs[i];
       if (external) value += settings_.external_force_mN[i];
       if (gravity) value += mass_[i] * settings_.gravity_mm_per_s2[i % 3];
       rhs[i] = value;

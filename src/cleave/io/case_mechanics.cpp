@@ -99,13 +99,16 @@ SimulationSettings parse_simulation_settings(const CaseFile& case_file) {
   if (const auto* v = json_find(*section, "frames_every")) s.frames_every = json_int_in(*v, at / "frames_every", 0, kMaxSteps);
   if (const auto* d = json_find(*section, "damping")) {
     const JsonPath here = at / "damping";
-    json_allow_keys(*d, here, {"mass_per_s", "stiffness_s", "numerical"});
+    json_allow_keys(*d, here, {"mass_per_s", "stiffness_s", "numerical", "high_frequency_radius"});
     if (const auto* v = json_find(*d, "mass_per_s"))
       s.mass_damping_per_s = json_number_in(*v, here / "mass_per_s", 0.0, kInf, "a non-negative mass damping in 1/s");
     if (const auto* v = json_find(*d, "stiffness_s"))
       s.stiffness_damping_s = json_number_in(*v, here / "stiffness_s", 0.0, kInf, "a non-negative stiffness damping in s");
     if (const auto* v = json_find(*d, "numerical"))
       s.numerical_damping = json_number_in(*v, here / "numerical", 0.0, 1.0 / 3.0, "a numerical damping (HHT -alpha) from 0 to 1/3");
+    if (const auto* v = json_find(*d, "high_frequency_radius"))
+      s.high_frequency_radius = json_number_in(*v, here / "high_frequency_radius", 0.0, 1.0,
+                                               "a spectral radius from 0 to 1 (generalized-alpha)");
   }
   if (const auto* v = json_find(*section, "fixed")) parse_fixed(*v, at / "fixed", s);
   if (const auto* v = json_find(*section, "gravity_mm_per_s2")) s.gravity_mm_per_s2 = json_vec3(*v, at / "gravity_mm_per_s2");

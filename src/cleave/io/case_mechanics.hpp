@@ -53,6 +53,8 @@ struct SimulationSettings {
   double mass_damping_per_s = 0;
   double stiffness_damping_s = 0;
   double numerical_damping = 0.2;  ///< HHT -alpha (fem/dynamics.hpp)
+  /// Generalized-alpha's spectral radius for what the step cannot resolve (0 to 1; unset: HHT).
+  std::optional<double> high_frequency_radius;
   std::vector<FixedBox> fixed_boxes;  ///< empty (and no fixed_surfaces) = free body ("none" / "free")
   std::vector<FixedSurface> fixed_surfaces;
   Vec3 gravity_mm_per_s2 = Vec3::Zero();

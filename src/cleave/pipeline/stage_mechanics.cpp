@@ -84,6 +84,7 @@ void stage_mechanics(RunContext& ctx) {
     ds.mass_damping_per_s = settings.mass_damping_per_s;
     ds.stiffness_damping_s = settings.stiffness_damping_s;
     ds.numerical_damping = settings.numerical_damping;
+    ds.high_frequency_radius = settings.high_frequency_radius;
     ds.fixed_vertices = held;
     ds.gravity_mm_per_s2 = settings.gravity_mm_per_s2;
     Dynamics sim(ctx.model, ctx.residual_stress_kPa, ds);
