@@ -10,9 +10,9 @@
 // loses 1.3 % of its energy per period). Why: with R frozen over a step, the undamped rule feeds
 // energy into fast rotating pieces; a cell cut loose or hanging by one face under 20 kPa grew to
 // 1e80 mm in 300 steps (tests/fem/extreme_values_test.cpp); at a = 0.1 it still swung, at 0.2 it rests.
-// `high_frequency_radius` switches to generalized-alpha (Chung & Hulbert 1993: the inertia taken
-// at n + 1 - alpha_m too), which can remove what the step cannot resolve entirely (radius 0): the
-// studio's wound opening at 30 ms steps, whose own modes are 3 ms fast.
+// `high_frequency_radius` switches to generalized-alpha (Chung & Hulbert 1993: the inertia is
+// weighted between n and n + 1 too), which can remove what the step cannot resolve entirely
+// (radius 0): the studio's wound opening at 30 ms steps, whose own modes are 3 ms fast.
 // What rotates: each cell c has the rotation R_c of the polar decomposition of its deformation
 // gradient at the cell centre. Its element force is
 //   f_e = R_c [ K^e (R_c^T x_e - X_e) + T^e sigma_c ],
@@ -86,12 +86,14 @@ struct DynamicsSettings {
   Vec3 gravity_mm_per_s2 = Vec3::Zero();
   double numerical_damping = 0.2;       ///< HHT alpha = -this (0 to 1/3): gamma = 1/2 + this, beta = (1 + this)^2 / 4
   /// Set (0 to 1): the generalized-alpha rule (Chung & Hulbert 1993) instead of HHT, with this
-  /// spectral radius for what the time step cannot resolve: alpha_m = (2 r - 1) / (r + 1),
-  /// alpha_f = r / (r + 1), the inertia taken at n + 1 - alpha_m, the forces at n + 1 - alpha_f
-  /// (numerical_damping is then unused). HHT's radius there is (1 - a) / (1 + a) = 0.67 at a = 0.2,
-  /// and its double eigenvalue makes such modes decay slowly at first: a wound opening at 30 ms
-  /// steps (its modes cross the cut in 3 ms) alternated by +-20 % of its width frame to frame for
-  /// 8 frames. r = 0 removes them by the third step; resolved motion stays second-order accurate.
+  /// spectral radius for what the time step cannot resolve: the inertia taken at n + 1 -
+  /// alpha_inertia, alpha_inertia = (2 r - 1) / (r + 1), the forces at n + 1 - alpha_forces,
+  /// alpha_forces = r / (r + 1) (numerical_damping is then unused). HHT's radius there is
+  /// (1 - a) / (1 + a) = 0.67 at a = 0.2, and such modes decay slowly at first: a wound opening at
+  /// 30 ms steps (its modes cross the cut in 3 ms) alternated by +-20 % of its width frame to
+  /// frame for 8 frames. r = 0 removes them by the third step; resolved motion stays second-order
+  /// accurate but is damped too (a cantilever mode at omega dt = 0.25 keeps 0.67 of its energy
+  /// over 4 periods); r = 1 is the undamped average-acceleration motion.
   std::optional<double> high_frequency_radius;
   Vector external_force_mN;             ///< constant nodal forces (3 n_v); empty = none
   /// With residual stress, the step's system includes the initial-stress stiffness of the tension
