@@ -20,18 +20,7 @@ namespace {
 
 constexpr double kStudioStep_s = 0.03;
 
-/// A 24 x 12 x 3 plate held at x = 0 under a uniform residual tension, a slit across its middle
-/// (cells x < 12, y < 6) cut before the first step.
-struct OpeningPlate {
-  TissueModel model = test::make_box_model({24, 12, 3}, 1.0, 20.0, 0.45);
-  std::vector<Vec6> stress;
-  OpeningPlate() {
-    Vec6 s;
-    s << 2.0, 1.0, 0, 0.3, 0, 0;
-    stress.assign(static_cast<std::size_t>(model.volume.cell_count()), s);
-    test::cut_plate_slit(model, 6);
-  }
-};
+using test::OpeningPlate;
 
 DynamicsSettings held_at_x0(const LinkedVolume& volume, std::optional<double> radius, double mass_damping_per_s) {
   DynamicsSettings settings;

@@ -18,18 +18,7 @@ namespace {
 
 constexpr double kDisplayStep_s = 1.0 / 60.0;
 
-/// A 24 x 12 x 3 plate held at x = 0, under a uniform residual tension, with a slit across its
-/// middle (cells x < 12, y < 6) cut before the first step: the wound opens.
-struct OpeningPlate {
-  TissueModel model = test::make_box_model({24, 12, 3}, 1.0, 20.0, 0.45);
-  std::vector<Vec6> stress;
-  OpeningPlate() {
-    Vec6 s;
-    s << 2.0, 1.0, 0, 0.3, 0, 0;
-    stress.assign(static_cast<std::size_t>(model.volume.cell_count()), s);
-    test::cut_plate_slit(model, 6);
-  }
-};
+using test::OpeningPlate;
 
 DynamicsSettings opening_settings(const LinkedVolume& volume, int iterations_per_step) {
   DynamicsSettings settings;

@@ -80,4 +80,18 @@ inline CutReport cut_plate_slit(TissueModel& model, int depth) {
   }));
 }
 
+/// A 24 x 12 x 3 plate of 1 mm cells (E = 20 kPa, nu = 0.45) under a uniform residual tension
+/// (2, 1, 0.3 kPa in x, y, xy), with the slit across its middle (cells x < 12, y < 6) cut: the
+/// wound opens when it is stepped (hold x = 0).
+struct OpeningPlate {
+  TissueModel model = make_box_model({24, 12, 3}, 1.0, 20.0, 0.45);
+  std::vector<Vec6> stress;
+  OpeningPlate() {
+    Vec6 s;
+    s << 2.0, 1.0, 0, 0.3, 0, 0;
+    stress.assign(static_cast<std::size_t>(model.volume.cell_count()), s);
+    cut_plate_slit(model, 6);
+  }
+};
+
 }  // namespace cleave::test
