@@ -13,19 +13,9 @@
 #include "cleave/fem/solve_static.hpp"
 #include "cleave/fem/stress_stiffness.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
+#include "cleave/solve/parallel_ranges.hpp"
 
 namespace cleave {
-namespace {
-
-/// Runs each(begin, end) over [0, dofs) in parallel ranges.
-template <typename Each>
-void for_dof_ranges(Eigen::Index dofs, Each&& each) {
-  constexpr Eigen::Index kDofsPerTask = Eigen::Index{1} << 14;
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, dofs, kDofsPerTask),
-                    [&](const tbb::blocked_range<Eigen::Index>& r) { each(r.begin(), r.end()); });
-}
-
-}  // namespace
 
 Dynamics::Dynamics(const TissueModel& model, std::vector<Vec6> residual_stress_kPa, DynamicsSettings settings)
     : model_(model), stress_kPa_(std::move(residual_stress_kPa)), settings_(std::move(settings)) {
@@ -363,7 +353,7 @@ SolveReport Dynamics::step(double dt) {
   // parallel passes (156k dofs at 44k cells: a serial Eigen expression per vector cost 1-2 ms).
   const Eigen::Index dofs = u_.size();
   Vector damped_velocity(dofs);
-  for_dof_ranges(dofs, [&](Eigen::Index begin, Eigen::Index end) {
+  for_each_range(dofs, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       const double damping_part = (1.0 - gamma / beta) * v_[i] + dt * (1.0 - 0.5 * gamma / beta) * a_[i];
       damped_velocity[i] = w * damping_part + (1.0 - w) * v_[i];
@@ -377,7 +367,7 @@ SolveReport Dynamics::step(double dt) {
   Vector du(dofs);
   const bool external = settings_.external_force_mN.size() != 0;
   const bool gravity = !settings_.gravity_mm_per_s2.isZero();
-  for_dof_ranges(dofs, [&](Eigen::Index begin, Eigen::Index end) {
+  for_each_range(dofs, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       if (fixed_[static_cast<std::size_t>(i)] != 0) {
         rhs[i] = 0.0;
@@ -426,7 +416,7 @@ SolveReport Dynamics::step(double dt) {
                                    "model's size ({:.3g} mm); add damping (simulation.damping) or use a smaller time step",
                                    time_s_, largest_mm, kDivergedSizes, size_mm));
 
-  for_dof_ranges(dofs, [&](Eigen::Index begin, Eigen::Index end) {
+  for_each_range(dofs, [&](Eigen::Index begin, Eigen::Index end) {
     for (Eigen::Index i = begin; i < end; ++i) {
       u_[i] += du[i];
       if (fixed_[static_cast<std::size_t>(i)] != 0) {

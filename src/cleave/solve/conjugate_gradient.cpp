@@ -1,7 +1,6 @@
 #include "cleave/solve/conjugate_gradient.hpp"
 
 #include <tbb/blocked_range.h>
-#include <tbb/parallel_for.h>
 #include <tbb/parallel_reduce.h>
 
 #include <algorithm>
@@ -9,7 +8,7 @@
 #include <functional>
 
 #include "cleave/solve/block_sparse_matrix.hpp"
-#include "cleave/solve/parallel_cast.hpp"
+#include "cleave/solve/parallel_ranges.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
 
 namespace cleave {
@@ -21,10 +20,9 @@ constexpr int kMaxRestarts = 2;
 
 enum class CgStop { converged_recurrence, out_of_iterations, breakdown };
 
-/// The iteration's vector work runs on all cores in fixed ranges, summed in a fixed order
-/// (deterministic: the same sums, whatever the threads): at 150k dofs each serial pass cost about
-/// 0.1 ms, six of them per iteration.
-constexpr Eigen::Index kEntriesPerRange = Eigen::Index{1} << 14;
+/// The iteration's vector work runs on all cores in fixed ranges (parallel_ranges.hpp), summed in
+/// a fixed order (deterministic: the same sums, whatever the threads): at 150k dofs each serial
+/// pass cost about 0.1 ms, six of them per iteration.
 
 template <typename RangeSum>
 double sum_over_ranges(Eigen::Index n, RangeSum&& range_sum) {
@@ -51,9 +49,8 @@ double step_along(double alpha, const Vector& p, const Vector& q, Vector& x, Vec
 
 /// p = z + beta p.
 void next_direction(const Vector& z, double beta, Vector& p) {
-  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, p.size(), kEntriesPerRange), [&](const tbb::blocked_range<Eigen::Index>& r) {
-    const Eigen::Index length = r.end() - r.begin();
-    p.segment(r.begin(), length) = z.segment(r.begin(), length) + beta * p.segment(r.begin(), length);
+  for_each_range(p.size(), [&](Eigen::Index begin, Eigen::Index end) {
+    p.segment(begin, end - begin) = z.segment(begin, end - begin) + beta * p.segment(begin, end - begin);
   });
 }
 

@@ -11,7 +11,7 @@
 #include "cleave/core/error.hpp"
 #include "cleave/solve/galerkin_operator.hpp"
 #include "cleave/solve/grid_level.hpp"
-#include "cleave/solve/parallel_cast.hpp"
+#include "cleave/solve/parallel_ranges.hpp"
 #include "cleave/solve/block_sparse_matrix.hpp"
 #include "cleave/solve/coarsest_factor.hpp"
 #include "cleave/solve/sparse_multiply.hpp"
