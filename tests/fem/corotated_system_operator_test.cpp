@@ -189,6 +189,32 @@ TEST(CorotatedSystemOperator, JacobiResidualInOnePassEqualsItFromTheAssembledSys
   }
 }
 
+// The residual b - A x in one pass with the product's per-vertex sum equals it from the assembled
+// matrix (fixed dofs: b - x), in double and in float.
+TEST(CorotatedSystemOperator, ResidualInOnePassEqualsItFromTheAssembledSystem) {
+  const Fixture f;
+  const SparseMatrix a = f.assembled();
+  const CorotatedSystemOperator op = f.op();
+  const Vector x = probe(a.rows());
+  const Vector b = 0.5 * probe(a.rows()).reverse();
+  const Vector expected = b - a * x;
+  const double scale = expected.lpNorm<Eigen::Infinity>();
+  Vector r;
+  op.residual(b, x, r);
+  EXPECT_LE((r - expected).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+  Eigen::VectorXf r_single, r_default;
+  op.residual(Eigen::VectorXf(b.cast<float>()), Eigen::VectorXf(x.cast<float>()), r_single);
+  op.VertexOperator::residual(Eigen::VectorXf(b.cast<float>()), Eigen::VectorXf(x.cast<float>()), r_default);
+  EXPECT_EQ(r_single, r_default);  // the same sums, subtracted in the same pass or the next
+  EXPECT_LE((r_single.cast<double>() - expected).lpNorm<Eigen::Infinity>(), 1e-4 * scale);
+  try {
+    op.residual(Vector(Vector::Zero(6)), x, r);
+    ADD_FAILURE() << "a short right-hand side was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("corotated system: right-hand side of 6 entries; expected {}", a.rows()));
+  }
+}
+
 TEST(CorotatedSystemOperator, WithoutTensionItIsTheCorotatedStiffnessPlusMass) {
   const Fixture f;
   CorotatedSystemOperator op;
@@ -233,10 +259,10 @@ TEST(CorotatedSystemOperator, RefusesStateThatDoesNotFitItsTopology) {
   }
 }
 
-// The AVX-512 cell passes (float: two cells per register; double: one) compute the portable
-// passes' products: an odd cell count (the last cell alone), neighbours of different materials in
-// one register, a cut, held dofs, with and without tension. All also meet the independently
-// gathered matrix.
+// The AVX-512 cell passes (float: two cells per register; double: one; both in corner modes)
+// compute the portable passes' products: an odd cell count (the last cell alone), neighbours of
+// different materials in one register, a cut, held dofs, with and without tension. All also meet
+// the independently gathered matrix.
 TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
   if (!avx512_cell_pass_supported()) GTEST_SKIP() << "this CPU has no AVX-512 F and DQ: only the portable pass runs";
   TissueModel model = test::make_box_model({7, 5, 3}, 1.5, 60.0, 0.42, [](const Vec3i& v) { return Label(v.x() % 3 == 1 ? 2 : 1); },
@@ -259,6 +285,7 @@ TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
     CorotatedSystemOperator op;
     op.set_topology(model.volume, table);
     EXPECT_TRUE(op.wide_cell_pass());  // the default where the CPU has it
+    EXPECT_TRUE(op.mode_cell_pass());  // isotropic materials on cubes
     op.set_state(rotations, with_tension ? std::span<const Vec6>(tension) : std::span<const Vec6>(), kStiff, kStress, kMass, mass, fixed);
     const Eigen::VectorXf x = probe(op.rows()).cast<float>();
     Eigen::VectorXf wide, portable;
@@ -285,6 +312,34 @@ TEST(CorotatedSystemOperator, WideCellPassEqualsThePortableOne) {
       }
     }
   }
+}
+
+// Element matrices without the corner-mode form (here an anisotropic material's) cannot take the
+// AVX-512 passes: the portable pass runs, and its products are still the gathered matrix's.
+TEST(CorotatedSystemOperator, ElementMatricesWithoutTheModeFormTakeThePortablePass) {
+  TissueModel model = test::make_box_model({4, 3, 3}, 1.0, 60.0, 0.42, [](const Vec3i&) { return Label{1}; }, {});
+  ElementTable table = make_element_table(model);
+  Mat6 anisotropic = table.per_material[0].elasticity_kPa;
+  anisotropic(0, 3) = anisotropic(3, 0) = 0.2 * anisotropic(3, 3);
+  table.per_material[0].stiffness = hex8_stiffness(table.cell_size_mm, anisotropic);
+  std::vector<Vec6> residual(static_cast<std::size_t>(model.volume.cell_count()), Vec6::Constant(3.0));
+  std::vector<Mat3> rotations;
+  std::vector<Vec6> tension;
+  cell_rotations_and_tension(model.volume, table, residual, test::turned_displacement(model.volume), rotations, tension);
+  const Vector mass = lumped_mass(model, table);
+  const std::vector<std::uint8_t> fixed = held_dofs(model.volume);
+  CorotatedSystemOperator op;
+  op.set_topology(model.volume, table);
+  op.set_state(rotations, tension, kStiff, kStress, kMass, mass, fixed);
+  EXPECT_FALSE(op.mode_cell_pass());
+  const Vector x = probe(op.rows());
+  Vector y;
+  op.multiply(x, y);
+  const Vector gathered = op.assembled_matrix() * x;
+  EXPECT_LE((y - gathered).lpNorm<Eigen::Infinity>(), 1e-12 * gathered.lpNorm<Eigen::Infinity>());
+  Eigen::VectorXf y_single;
+  op.multiply(Eigen::VectorXf(x.cast<float>()), y_single);
+  EXPECT_LE((y_single.cast<double>() - gathered).lpNorm<Eigen::Infinity>(), 3e-6 * gathered.lpNorm<Eigen::Infinity>());
 }
 
 /// Largest relative difference of two preconditioned vectors.

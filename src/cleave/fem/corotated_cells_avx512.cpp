@@ -16,7 +16,7 @@ __m512i halves(int lower, int upper) {
   return _mm512_inserti64x4(_mm512_castsi256_si512(_mm256_set1_epi32(lower)), _mm256_set1_epi32(upper), 1);
 }
 
-/// Two 8-float columns side by side: [first, second].
+/// Two 8-float rows side by side: [first, second].
 __m512 pair(const float* first, const float* second) {
   return _mm512_insertf32x8(_mm512_castps256_ps512(_mm256_loadu_ps(first)), _mm256_loadu_ps(second), 1);
 }
@@ -27,8 +27,72 @@ __m512i pair_ids(const std::int32_t* first, const std::int32_t* second) {
                             _mm256_loadu_si256(reinterpret_cast<const __m256i*>(second)), 1);
 }
 
+/// +1 in the lanes whose index has `bit` clear, -1 where it is set.
+__m512 butterfly_signs(int bit) {
+  alignas(64) float signs[16];
+  for (int lane = 0; lane < 16; ++lane) signs[lane] = (lane & bit) != 0 ? -1.0f : 1.0f;
+  return _mm512_load_ps(signs);
+}
+__m512d butterfly_signs_double(int bit) {
+  alignas(64) double signs[8];
+  for (int lane = 0; lane < 8; ++lane) signs[lane] = (lane & bit) != 0 ? -1.0 : 1.0;
+  return _mm512_load_pd(signs);
+}
+
+/// Lane permutations within each 8-lane half that swap two bits of the lane index (the mode
+/// pairings of fem/cube_corner_modes.hpp): [0, 2, 1, 3, ...] for bits 0 and 1, and so on.
+__m512i swapping_bits(int first, int second) {
+  alignas(64) std::int32_t index[16];
+  for (int lane = 0; lane < 16; ++lane) {
+    const int m = lane & 7;
+    const int a = (m >> first) & 1;
+    const int b = (m >> second) & 1;
+    index[lane] = (lane & 8) | (m & ~((1 << first) | (1 << second))) | (a << second) | (b << first);
+  }
+  return _mm512_load_si512(index);
+}
+__m512i swapping_bits_double(int first, int second) {
+  alignas(64) std::int64_t index[8];
+  for (int m = 0; m < 8; ++m) {
+    const int a = (m >> first) & 1;
+    const int b = (m >> second) & 1;
+    index[m] = (m & ~((1 << first) | (1 << second))) | (a << second) | (b << first);
+  }
+  return _mm512_load_si512(index);
+}
+
+/// The constants of a pass, made once per call of the kernel.
+struct FloatConstants {
+  __m512 sign[3] = {butterfly_signs(1), butterfly_signs(2), butterfly_signs(4)};
+  __m512i swap_xz = swapping_bits(0, 2);
+  __m512i swap_yz = swapping_bits(1, 2);
+};
+struct DoubleConstants {
+  __m512d sign[3] = {butterfly_signs_double(1), butterfly_signs_double(2), butterfly_signs_double(4)};
+  __m512i swap_xy = swapping_bits_double(0, 1);
+  __m512i swap_xz = swapping_bits_double(0, 2);
+  __m512i swap_yz = swapping_bits_double(1, 2);
+};
+
+/// The Walsh-Hadamard transform of each 8-lane half (it is its own inverse times 8): three
+/// butterflies, lane a with lane a ^ bit, the sum where the bit is clear and the difference
+/// where it is set.
+__m512 corner_modes(__m512 v, const FloatConstants& k) {
+  v = _mm512_fmadd_ps(v, k.sign[0], _mm512_permute_ps(v, 0xB1));                        // lanes 1 0 3 2
+  v = _mm512_fmadd_ps(v, k.sign[1], _mm512_permute_ps(v, 0x4E));                        // lanes 2 3 0 1
+  return _mm512_fmadd_ps(v, k.sign[2], _mm512_shuffle_f32x4(v, v, _MM_SHUFFLE(2, 3, 0, 1)));  // 4-lane groups swapped
+}
+__m512d corner_modes(__m512d v, const DoubleConstants& k) {
+  v = _mm512_fmadd_pd(v, k.sign[0], _mm512_permute_pd(v, 0x55));
+  v = _mm512_fmadd_pd(v, k.sign[1], _mm512_permutex_pd(v, _MM_SHUFFLE(1, 0, 3, 2)));
+  return _mm512_fmadd_pd(v, k.sign[2], _mm512_shuffle_f64x2(v, v, _MM_SHUFFLE(1, 0, 3, 2)));
+}
+
+/// Modes paired across x and y (bits 0 and 1): within each 4-lane group, lanes 0 2 1 3.
+__m512 paired_xy(__m512 v) { return _mm512_permute_ps(v, 0xD8); }
+
 /// Cells c and c + 1 (or c twice, `single`: only c is written).
-void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
+void cell_pair(const CorotatedCellsInput& in, const FloatConstants& constants, std::size_t c, bool single) {
   const std::size_t d = single ? c : c + 1;
   // The corners' x, y, z (world).
   const __m512i corner_ids = pair_ids(in.corners + 8 * c, in.corners + 8 * d);
@@ -46,36 +110,50 @@ void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
       rotation[k] = _mm512_permutex2var_ps(lower, halves(k, second), upper);
     }
   }
-  // Into the cells' frames: d_i = sum_j R_ji x_j.
+  // Into the cells' frames, d_i = sum_j R_ji x_j, and into modes.
   __m512 local[3];
   for (int i = 0; i < 3; ++i) {
     local[i] = _mm512_mul_ps(rotation[3 * i + 0], world[0]);
     local[i] = _mm512_fmadd_ps(rotation[3 * i + 1], world[1], local[i]);
     local[i] = _mm512_fmadd_ps(rotation[3 * i + 2], world[2], local[i]);
+    local[i] = corner_modes(local[i], constants);
   }
-  // f_i = sum_j K_ij d_j + s d_i, column b of each block times corner b's value.
-  const float* k_c = in.stiffness + 9 * 64 * static_cast<std::size_t>(in.material[c]);
-  const float* k_d = in.stiffness + 9 * 64 * static_cast<std::size_t>(in.material[d]);
-  const bool same_material = k_c == k_d;
-  const float* s_c = in.stress_stiffness != nullptr ? in.stress_stiffness + 64 * c : nullptr;
-  const float* s_d = in.stress_stiffness != nullptr ? in.stress_stiffness + 64 * d : nullptr;
-  __m512 f[3] = {_mm512_setzero_ps(), _mm512_setzero_ps(), _mm512_setzero_ps()};
-  for (int b = 0; b < 8; ++b) {
-    const __m512i spread = halves(b, 8 + b);  // corner b of each cell over its half
-    __m512 value[3];
-    for (int j = 0; j < 3; ++j) value[j] = _mm512_permutexvar_ps(spread, local[j]);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const std::size_t column = 64 * static_cast<std::size_t>(3 * i + j) + 8 * static_cast<std::size_t>(b);
-        const __m512 k = same_material ? _mm512_broadcast_f32x8(_mm256_loadu_ps(k_c + column)) : pair(k_c + column, k_d + column);
-        f[i] = _mm512_fmadd_ps(k, value[j], f[i]);
-      }
-    if (s_c != nullptr) {
-      const __m512 s = pair(s_c + 8 * b, s_d + 8 * b);
-      for (int i = 0; i < 3; ++i) f[i] = _mm512_fmadd_ps(s, value[i], f[i]);
+  // The blocks' mode coefficients, [3 i + j], each cell's in its half.
+  const float* k_c = in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]);
+  const float* k_d = in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[d]);
+  __m512 k[9];
+  for (std::size_t b = 0; b < 9; ++b)
+    k[b] = k_c == k_d ? _mm512_broadcast_f32x8(_mm256_loadu_ps(k_c + 8 * b)) : pair(k_c + 8 * b, k_d + 8 * b);
+  // The mode pairings: by_xy[j] is d^_j with the x and y modes swapped, and so on.
+  __m512 by_xy[3], by_xz[3], by_yz[3];
+  for (int j = 0; j < 3; ++j) {
+    by_xy[j] = paired_xy(local[j]);
+    by_xz[j] = _mm512_permutexvar_ps(constants.swap_xz, local[j]);
+    by_yz[j] = _mm512_permutexvar_ps(constants.swap_yz, local[j]);
+  }
+  // f^_i = k_ii d^_i + sum_{j != i} k_ij (d^_j paired as i, j).
+  __m512 f[3];
+  f[0] = _mm512_fmadd_ps(k[2], by_xz[2], _mm512_fmadd_ps(k[1], by_xy[1], _mm512_mul_ps(k[0], local[0])));
+  f[1] = _mm512_fmadd_ps(k[5], by_yz[2], _mm512_fmadd_ps(k[3], by_xy[0], _mm512_mul_ps(k[4], local[1])));
+  f[2] = _mm512_fmadd_ps(k[7], by_yz[1], _mm512_fmadd_ps(k[6], by_xz[0], _mm512_mul_ps(k[8], local[2])));
+  if (in.tension != nullptr) {
+    // s = sum_q t_q G_q for each component alike: the normal parts on the modes themselves, the
+    // shear parts on the pairs. t_q of each cell spread over its half (6 + 6 floats).
+    const __m512 t = _mm512_maskz_loadu_ps(single ? 0x3F : 0xFFF, in.tension + 6 * c);
+    __m512 spread[6];
+    for (int q = 0; q < 6; ++q) spread[q] = _mm512_permutexvar_ps(halves(q, single ? q : 6 + q), t);
+    __m512 g[6];
+    for (std::size_t q = 0; q < 6; ++q) g[q] = _mm512_mul_ps(spread[q], _mm512_broadcast_f32x8(_mm256_loadu_ps(in.stress_modes + 8 * q)));
+    const __m512 normal = _mm512_add_ps(g[0], _mm512_add_ps(g[1], g[2]));
+    for (int i = 0; i < 3; ++i) {
+      f[i] = _mm512_fmadd_ps(normal, local[i], f[i]);
+      f[i] = _mm512_fmadd_ps(g[3], by_xy[i], f[i]);
+      f[i] = _mm512_fmadd_ps(g[4], by_xz[i], f[i]);
+      f[i] = _mm512_fmadd_ps(g[5], by_yz[i], f[i]);
     }
   }
-  // Back into the world: out_i = sum_j R_ij f_j.
+  // Back to the corners (the 1 / 64 is in the coefficients) and into the world: out_i = sum_j R_ij f_j.
+  for (int i = 0; i < 3; ++i) f[i] = corner_modes(f[i], constants);
   __m512 out[3];
   for (int i = 0; i < 3; ++i) {
     out[i] = _mm512_mul_ps(rotation[i], f[0]);
@@ -93,42 +171,46 @@ void cell_pair(const CorotatedCellsInput& in, std::size_t c, bool single) {
   _mm512_storeu_ps(to + 32, _mm512_shuffle_f32x4(out[1], out[2], _MM_SHUFFLE(3, 2, 3, 2)));
 }
 
-/// Cell c in double: lanes are its 8 corners.
-void cell_double(const CorotatedCellsInputDouble& in, std::size_t c) {
+/// Cell c in double: lanes are its 8 corners (modes, once transformed).
+void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& constants, std::size_t c) {
   const __m256i offsets =
       _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.corners + 8 * c)), _mm256_set1_epi32(3));
   __m512d world[3];
   for (int j = 0; j < 3; ++j) world[j] = _mm512_i32gather_pd(offsets, in.x + j, 8);
   const double* r = in.rotation + 9 * c;  // R(i, j) at 3 j + i
-  // Into the cell's frame: d_i = sum_j R_ji x_j.
+  // Into the cell's frame, d_i = sum_j R_ji x_j, and into modes.
   __m512d local[3];
   for (int i = 0; i < 3; ++i) {
     local[i] = _mm512_mul_pd(_mm512_set1_pd(r[3 * i + 0]), world[0]);
     local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 1]), world[1], local[i]);
     local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
+    local[i] = corner_modes(local[i], constants);
   }
-  // f_i = sum_j K_ij d_j + s d_i, column b of each block (and of s) times corner b's value.
-  const double* k = in.stiffness + 9 * 64 * static_cast<std::size_t>(in.material[c]);
+  const double* k = in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]);
+  const auto coefficient = [&](int block) { return _mm512_loadu_pd(k + 8 * block); };
+  __m512d by_xy[3], by_xz[3], by_yz[3];
+  for (int j = 0; j < 3; ++j) {
+    by_xy[j] = _mm512_permutexvar_pd(constants.swap_xy, local[j]);
+    by_xz[j] = _mm512_permutexvar_pd(constants.swap_xz, local[j]);
+    by_yz[j] = _mm512_permutexvar_pd(constants.swap_yz, local[j]);
+  }
+  __m512d f[3];
+  f[0] = _mm512_fmadd_pd(coefficient(2), by_xz[2], _mm512_fmadd_pd(coefficient(1), by_xy[1], _mm512_mul_pd(coefficient(0), local[0])));
+  f[1] = _mm512_fmadd_pd(coefficient(5), by_yz[2], _mm512_fmadd_pd(coefficient(3), by_xy[0], _mm512_mul_pd(coefficient(4), local[1])));
+  f[2] = _mm512_fmadd_pd(coefficient(7), by_yz[1], _mm512_fmadd_pd(coefficient(6), by_xz[0], _mm512_mul_pd(coefficient(8), local[2])));
   const double* t = in.tension != nullptr ? in.tension + 6 * c : nullptr;
-  const bool with_tension = t != nullptr && (t[0] != 0 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 0 || t[5] != 0);
-  __m512d f[3] = {_mm512_setzero_pd(), _mm512_setzero_pd(), _mm512_setzero_pd()};
-  for (int b = 0; b < 8; ++b) {
-    const __m512i spread = _mm512_set1_epi64(b);
-    __m512d value[3];
-    for (int j = 0; j < 3; ++j) value[j] = _mm512_permutexvar_pd(spread, local[j]);
-    for (int i = 0; i < 3; ++i)
-      for (int j = 0; j < 3; ++j) {
-        const __m512d column = _mm512_loadu_pd(k + 64 * static_cast<std::size_t>(3 * i + j) + 8 * static_cast<std::size_t>(b));
-        f[i] = _mm512_fmadd_pd(column, value[j], f[i]);
-      }
-    if (with_tension) {
-      // Column b of s = sum_q t_q G_q.
-      __m512d s = _mm512_mul_pd(_mm512_set1_pd(t[0]), _mm512_loadu_pd(in.stress_basis + 8 * static_cast<std::size_t>(b)));
-      for (int q = 1; q < 6; ++q)
-        s = _mm512_fmadd_pd(_mm512_set1_pd(t[q]), _mm512_loadu_pd(in.stress_basis + 64 * static_cast<std::size_t>(q) + 8 * static_cast<std::size_t>(b)), s);
-      for (int i = 0; i < 3; ++i) f[i] = _mm512_fmadd_pd(s, value[i], f[i]);
+  if (t != nullptr && (t[0] != 0 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 0 || t[5] != 0)) {
+    __m512d g[6];
+    for (std::size_t q = 0; q < 6; ++q) g[q] = _mm512_mul_pd(_mm512_set1_pd(t[q]), _mm512_loadu_pd(in.stress_modes + 8 * q));
+    const __m512d normal = _mm512_add_pd(g[0], _mm512_add_pd(g[1], g[2]));
+    for (int i = 0; i < 3; ++i) {
+      f[i] = _mm512_fmadd_pd(normal, local[i], f[i]);
+      f[i] = _mm512_fmadd_pd(g[3], by_xy[i], f[i]);
+      f[i] = _mm512_fmadd_pd(g[4], by_xz[i], f[i]);
+      f[i] = _mm512_fmadd_pd(g[5], by_yz[i], f[i]);
     }
   }
+  for (int i = 0; i < 3; ++i) f[i] = corner_modes(f[i], constants);
   // Back into the world: out_i = sum_j R_ij f_j.
   double* to = in.per_cell + 24 * c;
   for (int i = 0; i < 3; ++i) {
@@ -142,13 +224,15 @@ void cell_double(const CorotatedCellsInputDouble& in, std::size_t c) {
 }  // namespace
 
 void corotated_cells_avx512(const CorotatedCellsInputDouble& in, std::size_t begin, std::size_t end) {
-  for (std::size_t c = begin; c < end; ++c) cell_double(in, c);
+  const DoubleConstants constants;
+  for (std::size_t c = begin; c < end; ++c) cell_double(in, constants, c);
 }
 
 void corotated_cells_avx512(const CorotatedCellsInput& in, std::size_t begin, std::size_t end) {
+  const FloatConstants constants;
   std::size_t c = begin;
-  for (; c + 1 < end; c += 2) cell_pair(in, c, false);
-  if (c < end) cell_pair(in, c, true);
+  for (; c + 1 < end; c += 2) cell_pair(in, constants, c, false);
+  if (c < end) cell_pair(in, constants, c, true);
 }
 
 }  // namespace cleave

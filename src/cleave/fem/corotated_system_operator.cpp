@@ -2,12 +2,16 @@
 
 #include <fmt/format.h>
 #include <algorithm>
+#include <chrono>
+#include <cstdio>
+#include <cstdlib>
 #include <type_traits>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/fem/corotated_cells_avx512.hpp"
+#include "cleave/fem/cube_corner_modes.hpp"
 #include "cleave/fem/fixed_dofs.hpp"
 #include "cleave/fem/vertex_block_matrix.hpp"
 #include "cleave/grid/vertex_corner_slots.hpp"
@@ -57,6 +61,47 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
   corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
+  // The element matrices in corner modes, for the AVX-512 passes (none: the portable pass).
+  stiffness_modes_.clear();
+  stress_modes_.reset();
+  if (const auto stress = corner_mode_form(table.stress_stiffness)) {
+    for (const ElementMatrices& material : table.per_material) {
+      const auto form = corner_mode_form(material.stiffness);
+      if (!form) {
+        stiffness_modes_.clear();
+        return;
+      }
+      stiffness_modes_.push_back(*form);
+    }
+    stress_modes_ = *stress;
+  }
+}
+
+template <typename Scalar>
+void CorotatedSystemOperator::set_mode_coefficients(Precision<Scalar>& p, double c_stiff) const {
+  p.stiffness_modes.resize(72 * stiffness_modes_.size());
+  for (std::size_t m = 0; m < stiffness_modes_.size(); ++m)
+    for (std::size_t b = 0; b < 9; ++b)
+      for (Eigen::Index mode = 0; mode < 8; ++mode)
+        p.stiffness_modes[72 * m + 8 * b + static_cast<std::size_t>(mode)] = static_cast<Scalar>(c_stiff * stiffness_modes_[m][b][mode]);
+  p.stress_modes.assign(stress_modes_ ? 48 : 0, Scalar{0});
+  if (stress_modes_)
+    for (std::size_t q = 0; q < 6; ++q)
+      for (Eigen::Index mode = 0; mode < 8; ++mode) p.stress_modes[8 * q + static_cast<std::size_t>(mode)] = static_cast<Scalar>((*stress_modes_)[q][mode]);
+}
+
+bool CorotatedSystemOperator::mode_cell_pass() const {
+  return wide_cell_pass_ && stress_modes_.has_value() && !stiffness_modes_.empty();
+}
+
+void CorotatedSystemOperator::form_stress_stiffness() const {
+  const std::size_t cells = material_.size();
+  if (!with_tension_ || single_.stress_stiffness.size() == cells) return;
+  single_.stress_stiffness.resize(cells);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t c = r.begin(); c < r.end(); ++c)
+      single_.stress_stiffness[c] = stress_stiffness_of(twin_.tension[c], twin_.stress_basis).cast<float>();
+  });
 }
 
 void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::span<const Vec6> tension_kPa, double c_stiff,
@@ -96,6 +141,8 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
           }
   }
   split_corner_diagonals();
+  set_mode_coefficients(single_, c_stiff);
+  set_mode_coefficients(twin_, c_stiff);
   for (std::size_t k = 0; k < 6; ++k) {
     for (int a = 0; a < kCornerCount; ++a)
       stress_diagonal_basis_[static_cast<std::size_t>(a)][static_cast<Eigen::Index>(k)] = table_->stress_stiffness[k](a, a);
@@ -105,17 +152,17 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   single_.rotation.resize(cells);
   twin_.tension.resize(with_tension_ ? cells : 0);
   single_.tension.resize(with_tension_ ? cells : 0);
-  single_.stress_stiffness.resize(with_tension_ ? cells : 0);
+  single_.stress_stiffness.clear();  // formed by the portable float pass when it runs
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) {
       single_.rotation[c] = rotations[c].cast<float>();
       if (with_tension_) {
         twin_.tension[c] = c_stress * tension_kPa[c];
         single_.tension[c] = twin_.tension[c].cast<float>();
-        single_.stress_stiffness[c] = stress_stiffness_of(twin_.tension[c], twin_.stress_basis).cast<float>();
       }
     }
   });
+  if (!mode_cell_pass()) form_stress_stiffness();
   twin_.mass_term = c_mass * mass_kg;
   for (std::size_t i = 0; i < dofs; ++i)
     if (fixed[i] != 0) twin_.mass_term[static_cast<Eigen::Index>(i)] = 0;
@@ -150,39 +197,47 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
   const std::size_t cells = material_.size();
   p.per_cell.resize(24 * cells);
   if constexpr (std::is_same_v<Scalar, float>) {
-    if (wide_cell_pass_ && cells > 0) {
-      static_assert(sizeof(CornerBlocks<float>) == 9 * 64 * sizeof(float) && sizeof(Eigen::Matrix3f) == 9 * sizeof(float) &&
-                    sizeof(Eigen::Matrix<float, 8, 8>) == 64 * sizeof(float) && sizeof(std::array<VertexId, 8>) == 8 * sizeof(std::int32_t));
+    if (mode_cell_pass() && cells > 0) {
+      static_assert(sizeof(Eigen::Matrix3f) == 9 * sizeof(float) && sizeof(Eigen::Matrix<float, 6, 1>) == 6 * sizeof(float) &&
+                    sizeof(std::array<VertexId, 8>) == 8 * sizeof(std::int32_t));
       CorotatedCellsInput in;
       in.x = x->data();
       in.corners = volume_->cell_vertices(0).data();
       in.rotation = p.rotation.front().data();
       in.material = material_.data();
-      in.stiffness = p.stiffness_by_component.front().front().data();
-      in.stress_stiffness = with_tension_ ? p.stress_stiffness.front().data() : nullptr;
+      in.stiffness_modes = p.stiffness_modes.data();
+      in.stress_modes = p.stress_modes.data();
+      in.tension = with_tension_ ? p.tension.front().data() : nullptr;
       in.per_cell = p.per_cell.data();
+      auto t0=std::chrono::steady_clock::now();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
                         [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
+      auto t1=std::chrono::steady_clock::now();
       sum_per_vertex(p, x_in, *x, finish);
+      auto t2=std::chrono::steady_clock::now();
+      static double a=0,b=0; static long n=0; a+=std::chrono::duration<double,std::milli>(t1-t0).count(); b+=std::chrono::duration<double,std::milli>(t2-t1).count();
+      if(++n%100==0) std::fprintf(stderr,"cells %.3f sum %.3f\n",a/n,b/n);
+      if (std::getenv("SERIAL")) { auto s0=std::chrono::steady_clock::now(); for(int rep=0;rep<10;++rep) corotated_cells_avx512(in, 0, cells); auto s1=std::chrono::steady_clock::now(); std::fprintf(stderr,"serial %.3f\n",std::chrono::duration<double,std::milli>(s1-s0).count()/10);
+        s0=std::chrono::steady_clock::now(); for(int rep=0;rep<220;++rep) corotated_cells_avx512(in, 0, 2000); s1=std::chrono::steady_clock::now(); std::fprintf(stderr,"cached serial (scaled to all cells) %.3f\n",std::chrono::duration<double,std::milli>(s1-s0).count()/10);}
       return;
     }
-  } else if (wide_cell_pass_ && cells > 0) {
-    static_assert(sizeof(CornerBlocks<double>) == 9 * 64 * sizeof(double) && sizeof(Mat3) == 9 * sizeof(double) &&
-                  sizeof(Eigen::Matrix<double, 6, 1>) == 6 * sizeof(double) && sizeof(Eigen::Matrix<double, 8, 8>) == 64 * sizeof(double));
+  } else if (mode_cell_pass() && cells > 0) {
+    static_assert(sizeof(Mat3) == 9 * sizeof(double) && sizeof(Eigen::Matrix<double, 6, 1>) == 6 * sizeof(double));
     CorotatedCellsInputDouble in;
     in.x = x->data();
     in.corners = volume_->cell_vertices(0).data();
     in.rotation = rotations_.front().data();
     in.material = material_.data();
-    in.stiffness = p.stiffness_by_component.front().front().data();
+    in.stiffness_modes = p.stiffness_modes.data();
+    in.stress_modes = p.stress_modes.data();
     in.tension = with_tension_ ? p.tension.front().data() : nullptr;
-    in.stress_basis = p.stress_basis.front().data();
     in.per_cell = p.per_cell.data();
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
                       [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
     sum_per_vertex(p, x_in, *x, finish);
     return;
   }
+  if constexpr (std::is_same_v<Scalar, float>) form_stress_stiffness();
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
     for (std::size_t c = r.begin(); c < r.end(); ++c) {
       const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
@@ -206,7 +261,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       }
       if constexpr (std::is_same_v<Scalar, float>) {
         if (with_tension_) {
-          const Eigen::Matrix<float, 8, 8>& s = p.stress_stiffness[c];
+          const Eigen::Matrix<float, 8, 8>& s = p.stress_stiffness[c];  // formed before the pass
           for (std::size_t i = 0; i < 3; ++i) f[i].noalias() += s.lazyProduct(d[i]);
         }
       } else if (with_tension_) {
@@ -260,6 +315,27 @@ void CorotatedSystemOperator::fused_jacobi_residual(const Precision<Scalar>& p,
     const auto i = 3 * static_cast<Eigen::Index>(v);
     z.template segment<3>(i) = inverse_diagonal[static_cast<std::size_t>(v)] * (b.template segment<3>(i) - ax);
   });
+}
+
+template <typename Scalar>
+void CorotatedSystemOperator::fused_residual(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                             const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                                             Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) const {
+  if (b.size() != rows())
+    throw InputError(fmt::format("corotated system: right-hand side of {} entries; expected {}", b.size(), rows()));
+  r.resize(rows());
+  apply(p, x, [&](VertexId v, const Eigen::Matrix<Scalar, 3, 1>& ax) {
+    const auto i = 3 * static_cast<Eigen::Index>(v);
+    r.template segment<3>(i) = b.template segment<3>(i) - ax;
+  });
+}
+
+void CorotatedSystemOperator::residual(const Eigen::VectorXf& b, const Eigen::VectorXf& x, Eigen::VectorXf& r) const {
+  fused_residual(single_, b, x, r);
+}
+
+void CorotatedSystemOperator::residual(const Eigen::VectorXd& b, const Eigen::VectorXd& x, Eigen::VectorXd& r) const {
+  fused_residual(twin_, b, x, r);
 }
 
 void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const {

@@ -7,13 +7,14 @@
 // in the cache; R and the tension t per cell); then per vertex, the sum over its cells plus the
 // mass term. It streams the cells' rotations, tension and corners and a 24-value buffer per cell
 // (about 12 MB at 44k cells in float) instead of the assembled blocks (53 MB in float, 106 MB in
-// double), and a step no longer assembles the blocks at all. The float product (the multigrid
-// cycle's, 4 per CG iteration) reads each cell's 8 x 8 stress stiffness, formed once per
-// set_state (256 B per cell, 11 MB at 44k cells): forming it from t at every product was 40 % of
-// the product's time (1.5 -> 0.9 ms at 44k cells, session 19); the double product still forms it.
-// Where the CPU has AVX-512, the float cell pass takes two cells per 16-float register
-// (fem/corotated_cells_avx512.hpp; 0.83-0.87 of the portable pass's product at 44k cells), the
-// double pass one cell per 8-double register.
+// double), and a step no longer assembles the blocks at all. Where the CPU has AVX-512, the cell
+// passes work in corner modes (fem/cube_corner_modes.hpp), where each 8 x 8 block of K^e and of
+// the stress stiffness is a multiply and a lane permutation: float two cells per 16-float
+// register, double one cell per 8-double register (fem/corotated_cells_avx512.hpp), reading the
+// cell's 6 tension values. At 44k cells the double product takes 1.1 ms instead of 1.3 (dense
+// blocks) and the float 0.75 ms (as the dense AVX-512 pass: gathers and permutations bound it),
+// against 1.1 ms for the portable pass, which reads an 8 x 8 stress stiffness per cell formed
+// once per state.
 //
 //   CorotatedSystemOperator op;
 //   op.set_topology(volume, table);                  // after construction and after every cut
@@ -24,6 +25,7 @@
 // products.
 #include <array>
 #include <cstdint>
+#include <optional>
 #include <span>
 #include <vector>
 
@@ -51,6 +53,8 @@ class CorotatedSystemOperator final : public VertexOperator {
   void multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const override;
   void multiply(const Eigen::VectorXd& x, Eigen::VectorXd& y) const override;
   /// In one pass with the product's per-vertex sum (the product's values never stored).
+  void residual(const Eigen::VectorXf& b, const Eigen::VectorXf& x, Eigen::VectorXf& r) const override;
+  void residual(const Eigen::VectorXd& b, const Eigen::VectorXd& x, Eigen::VectorXd& r) const override;
   void jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, const Eigen::VectorXf& x,
                        Eigen::VectorXf& z) const override;
   void jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
@@ -67,6 +71,10 @@ class CorotatedSystemOperator final : public VertexOperator {
   /// asked for on a CPU without it. Off: the portable pass (one cell per 8-float register).
   void set_wide_cell_pass(bool on);
   bool wide_cell_pass() const { return wide_cell_pass_; }
+  /// The AVX-512 passes run: they are on and the table's element matrices have the corner-mode
+  /// form they compute with (fem/cube_corner_modes.hpp; any table of isotropic materials has
+  /// it). Otherwise the portable pass runs.
+  bool mode_cell_pass() const;
 
  private:
   /// Cell values by component: for component i (x, y, z), the 8 corners' values (a SIMD register
@@ -83,10 +91,11 @@ class CorotatedSystemOperator final : public VertexOperator {
     std::array<Eigen::Matrix<Scalar, 8, 8>, 6> stress_basis;  ///< G_k
     std::vector<Eigen::Matrix<Scalar, 3, 3>> rotation;  ///< per cell (float only; double reads rotations_)
     std::vector<Eigen::Matrix<Scalar, 6, 1>> tension;   ///< per cell: c_stress t
-    /// Per cell: its stress stiffness sum_k (c_stress t_k) G_k, formed once per state (float
-    /// only: the cycle's 4 products per iteration read it instead of forming it from the 6
-    /// tension values each time; the CG's double product still forms it).
-    std::vector<Eigen::Matrix<Scalar, 8, 8>> stress_stiffness;
+    /// Per cell: its stress stiffness sum_k (c_stress t_k) G_k, formed once per state for the
+    /// portable float pass (form_stress_stiffness; the mode pass reads the 6 tension values).
+    mutable std::vector<Eigen::Matrix<Scalar, 8, 8>> stress_stiffness;
+    std::vector<Scalar> stiffness_modes;  ///< per material slot: c_stiff K^e's 9 blocks in modes, 8 each
+    std::vector<Scalar> stress_modes;     ///< the six G_k in modes, 8 each (fem/cube_corner_modes.hpp)
     Eigen::Matrix<Scalar, Eigen::Dynamic, 1> mass_term;  ///< per dof: c_mass m (0 on fixed dofs)
     mutable Eigen::Matrix<Scalar, Eigen::Dynamic, 1> masked;  ///< x with fixed dofs zeroed
     mutable std::vector<Scalar> per_cell;                     ///< 24 per cell: 8 x, 8 y, 8 z
@@ -99,6 +108,9 @@ class CorotatedSystemOperator final : public VertexOperator {
   template <typename Scalar, typename Finish>
   void sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
                       const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, const Finish& finish) const;
+  template <typename Scalar>
+  void fused_residual(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                      const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) const;
   template <typename Scalar>
   void fused_jacobi_residual(const Precision<Scalar>& p, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
                              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
@@ -124,6 +136,15 @@ class CorotatedSystemOperator final : public VertexOperator {
   /// Per corner a: G_k(a, a) for the 6 components k (the stress stiffness's diagonal, gathered).
   std::array<Eigen::Matrix<double, 6, 1>, 8> stress_diagonal_basis_{};
   void split_corner_diagonals();
+
+  /// The element table's K^e per material and G_k in corner modes (fem/cube_corner_modes.hpp);
+  /// empty where they do not have that form.
+  std::vector<std::array<Eigen::Matrix<double, 8, 1>, 9>> stiffness_modes_;
+  std::optional<std::array<Eigen::Matrix<double, 8, 1>, 6>> stress_modes_;
+  template <typename Scalar>
+  void set_mode_coefficients(Precision<Scalar>& p, double c_stiff) const;
+  /// single_.stress_stiffness, for the portable float pass, once per state.
+  void form_stress_stiffness() const;
 
   const LinkedVolume* volume_ = nullptr;
   const ElementTable* table_ = nullptr;

@@ -10,17 +10,17 @@ constexpr std::size_t kVerticesPerTask = 2048;
 
 }  // namespace
 
+namespace {
+
 template <typename Scalar>
-void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
-              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) {
+void product_then_residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                           const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) {
   a.multiply(x, r);
   tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, r.size(), 3 * kVerticesPerTask), [&](const tbb::blocked_range<Eigen::Index>& range) {
     const Eigen::Index n = range.end() - range.begin();
     r.segment(range.begin(), n) = b.segment(range.begin(), n) - r.segment(range.begin(), n);
   });
 }
-
-namespace {
 
 template <typename Scalar>
 void product_then_jacobi(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
@@ -38,6 +38,20 @@ void product_then_jacobi(const VertexOperator& a, const std::vector<Eigen::Matri
 }
 
 }  // namespace
+
+void VertexOperator::residual(const Eigen::VectorXf& b, const Eigen::VectorXf& x, Eigen::VectorXf& r) const {
+  product_then_residual(*this, b, x, r);
+}
+
+void VertexOperator::residual(const Eigen::VectorXd& b, const Eigen::VectorXd& x, Eigen::VectorXd& r) const {
+  product_then_residual(*this, b, x, r);
+}
+
+template <typename Scalar>
+void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+              const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) {
+  a.residual(b, x, r);
+}
 
 void VertexOperator::jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, const Eigen::VectorXf& x,
                                      Eigen::VectorXf& z) const {

@@ -34,6 +34,10 @@ class VertexOperator {
   virtual SparseMatrix assembled_matrix() const = 0;
   /// Per dof: 1 where A has an identity row (a fixed dof).
   virtual const std::vector<std::uint8_t>& fixed_dofs() const = 0;
+  /// r = b - A x (r is resized, and must not be x or b). By default a product, then a pass; an
+  /// operator that sums its products per vertex may do both at once.
+  virtual void residual(const Eigen::VectorXf& b, const Eigen::VectorXf& x, Eigen::VectorXf& r) const;
+  virtual void residual(const Eigen::VectorXd& b, const Eigen::VectorXd& x, Eigen::VectorXd& r) const;
   /// z = D^-1 (b - A x), D^-1 per vertex `inverse_diagonal` (a smoothing step; z is resized, and
   /// must not be x or b). By default a product, then a pass over the vertices; an operator that
   /// sums its products per vertex may do both at once.
