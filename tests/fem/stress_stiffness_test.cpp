@@ -78,6 +78,37 @@ TEST(StressStiffness, TensilePartDropsTheCompressiveEigenvalues) {
   EXPECT_LT((tensile_part(rotated({-20, 8, -5})) - rotated({0, 8, 0})).norm(), 1e-12 * 20);
 }
 
+// Mixed stresses (the closed-form decomposition): the tensile part equals the one from the
+// iterative (QR) decomposition, also with a double eigenvalue, with an eigenvalue near zero and
+// with nearly equal eigenvalues of different sign; to rounding where the eigenvalues are well
+// apart, to 1e-8 of the stress near double ones (the closed form's rounding there: 2e-9 measured).
+TEST(StressStiffness, TensilePartOfMixedStressesEqualsTheFullDecompositions) {
+  const auto reference = [](const Vec6& s) {
+    Eigen::SelfAdjointEigenSolver<Mat3> eigen(from_voigt(s));
+    const Mat3& axes = eigen.eigenvectors();
+    return to_voigt(axes * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * axes.transpose());
+  };
+  const std::vector<Vec3> spectra = {{20, -8, 5},   {-20, 8, -5},   {3, 3, -1},      {-3, -3, 1},    {7, 1e-9, -2},
+                                     {5, -1e-9, 4}, {1e-7, -1e-7, 9}, {-4, 2, 2.000001}, {1, -1, 1e-14}, {2.5, -0.1, 0.3}};
+  int checked = 0;
+  for (const Vec3& spectrum : spectra)
+    for (int turn = 0; turn < 12; ++turn) {
+      const Mat3 axes = Eigen::AngleAxisd(0.37 * turn + 0.1, Vec3(std::sin(turn), 1.0, std::cos(2.0 * turn)).normalized()).toRotationMatrix();
+      const Vec6 s = to_voigt(axes * spectrum.asDiagonal() * axes.transpose());
+      const double scale = spectrum.cwiseAbs().maxCoeff();
+      EXPECT_LE((tensile_part(s) - reference(s)).lpNorm<Eigen::Infinity>(), 1e-8 * scale) << "spectrum " << spectrum.transpose();
+      // Well separated: to rounding.
+      if (spectrum.isApprox(Vec3(20, -8, 5)) || spectrum.isApprox(Vec3(2.5, -0.1, 0.3))) {
+        EXPECT_LE((tensile_part(s) - reference(s)).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+      }
+      // Never more compressive than the stress, never compressive at all.
+      Eigen::SelfAdjointEigenSolver<Mat3> tensile(from_voigt(tensile_part(s)));
+      EXPECT_GE(tensile.eigenvalues().minCoeff(), -1e-12 * scale) << "spectrum " << spectrum.transpose();
+      ++checked;
+    }
+  EXPECT_EQ(checked, 120);
+}
+
 TEST(StressStiffness, ACellCarriesItsResidualStressPlusTheElasticStressOfItsStretchInItsOwnFrame) {
   // Every vertex moved by x -> R S x (S a stretch, R a large rotation): each cell's corotated
   // stress is the residual one plus D (S - I), whatever R is; its tensile part is what is kept.
