@@ -171,6 +171,21 @@ void cell_pair(const CorotatedCellsInput& in, const FloatConstants& constants, s
   _mm512_storeu_ps(to + 32, _mm512_shuffle_f32x4(out[1], out[2], _MM_SHUFFLE(3, 2, 3, 2)));
 }
 
+/// f^_i = k_ii d^_i + sum_{j != i} k_ij (d^_j paired as i, j) for one cell's modes `local`
+/// (k: its material's 72 coefficients), and the pairings of `local` for the stress parts.
+void stiffness_in_modes(const double* k, const DoubleConstants& constants, const __m512d local[3], __m512d by_xy[3], __m512d by_xz[3],
+                        __m512d by_yz[3], __m512d f[3]) {
+  const auto coefficient = [&](int block) { return _mm512_loadu_pd(k + 8 * block); };
+  for (int j = 0; j < 3; ++j) {
+    by_xy[j] = _mm512_permutexvar_pd(constants.swap_xy, local[j]);
+    by_xz[j] = _mm512_permutexvar_pd(constants.swap_xz, local[j]);
+    by_yz[j] = _mm512_permutexvar_pd(constants.swap_yz, local[j]);
+  }
+  f[0] = _mm512_fmadd_pd(coefficient(2), by_xz[2], _mm512_fmadd_pd(coefficient(1), by_xy[1], _mm512_mul_pd(coefficient(0), local[0])));
+  f[1] = _mm512_fmadd_pd(coefficient(5), by_yz[2], _mm512_fmadd_pd(coefficient(3), by_xy[0], _mm512_mul_pd(coefficient(4), local[1])));
+  f[2] = _mm512_fmadd_pd(coefficient(7), by_yz[1], _mm512_fmadd_pd(coefficient(6), by_xz[0], _mm512_mul_pd(coefficient(8), local[2])));
+}
+
 /// Cell c in double: lanes are its 8 corners (modes, once transformed).
 void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& constants, std::size_t c) {
   const __m256i offsets =
@@ -186,18 +201,9 @@ void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& con
     local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
     local[i] = corner_modes(local[i], constants);
   }
-  const double* k = in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]);
-  const auto coefficient = [&](int block) { return _mm512_loadu_pd(k + 8 * block); };
   __m512d by_xy[3], by_xz[3], by_yz[3];
-  for (int j = 0; j < 3; ++j) {
-    by_xy[j] = _mm512_permutexvar_pd(constants.swap_xy, local[j]);
-    by_xz[j] = _mm512_permutexvar_pd(constants.swap_xz, local[j]);
-    by_yz[j] = _mm512_permutexvar_pd(constants.swap_yz, local[j]);
-  }
   __m512d f[3];
-  f[0] = _mm512_fmadd_pd(coefficient(2), by_xz[2], _mm512_fmadd_pd(coefficient(1), by_xy[1], _mm512_mul_pd(coefficient(0), local[0])));
-  f[1] = _mm512_fmadd_pd(coefficient(5), by_yz[2], _mm512_fmadd_pd(coefficient(3), by_xy[0], _mm512_mul_pd(coefficient(4), local[1])));
-  f[2] = _mm512_fmadd_pd(coefficient(7), by_yz[1], _mm512_fmadd_pd(coefficient(6), by_xz[0], _mm512_mul_pd(coefficient(8), local[2])));
+  stiffness_in_modes(in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]), constants, local, by_xy, by_xz, by_yz, f);
   const double* t = in.tension != nullptr ? in.tension + 6 * c : nullptr;
   if (t != nullptr && (t[0] != 0 || t[1] != 0 || t[2] != 0 || t[3] != 0 || t[4] != 0 || t[5] != 0)) {
     __m512d g[6];
@@ -221,7 +227,52 @@ void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& con
   }
 }
 
+
+/// Cell c's elastic and stress forces in double: R [K^e (R^T (X_e + x_e) - X_e) + T^e s].
+void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constants, std::size_t c) {
+  const __m256i offsets =
+      _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.corners + 8 * c)), _mm256_set1_epi32(3));
+  // The corners' positions relative to corner 0 at rest, h (a_x, a_y, a_z), plus their displacement.
+  __m512d rest[3];
+  for (int j = 0; j < 3; ++j) rest[j] = _mm512_mul_pd(_mm512_set1_pd(0.5 * in.cell_size_mm), _mm512_sub_pd(_mm512_set1_pd(1.0), constants.sign[j]));
+  __m512d world[3];
+  for (int j = 0; j < 3; ++j) world[j] = _mm512_add_pd(rest[j], _mm512_i32gather_pd(offsets, in.x + j, 8));
+  const double* r = in.rotation + 9 * c;  // R(i, j) at 3 j + i
+  // d_i = sum_j R_ji (X + x)_j - X_i in the cell's frame, into modes (the rigid translation, mode
+  // 0, has no stiffness: no need to take corner 0's displacement off).
+  __m512d local[3];
+  for (int i = 0; i < 3; ++i) {
+    local[i] = _mm512_mul_pd(_mm512_set1_pd(r[3 * i + 0]), world[0]);
+    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 1]), world[1], local[i]);
+    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
+    local[i] = corner_modes(_mm512_sub_pd(local[i], rest[i]), constants);
+  }
+  __m512d by_xy[3], by_xz[3], by_yz[3];
+  __m512d f[3];
+  stiffness_in_modes(in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]), constants, local, by_xy, by_xz, by_yz, f);
+  for (int i = 0; i < 3; ++i) f[i] = corner_modes(f[i], constants);
+  // The stress forces T^e s at the corners, component by component.
+  if (in.stress != nullptr) {
+    const double* s = in.stress + 6 * c;
+    for (int i = 0; i < 3; ++i)
+      for (int k = 0; k < 6; ++k)
+        f[i] = _mm512_fmadd_pd(_mm512_set1_pd(s[k]), _mm512_loadu_pd(in.stress_divergence + 8 * (3 * k + i)), f[i]);
+  }
+  double* to = in.per_cell + 24 * c;
+  for (int i = 0; i < 3; ++i) {
+    __m512d out = _mm512_mul_pd(_mm512_set1_pd(r[i]), f[0]);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[3 + i]), f[1], out);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[6 + i]), f[2], out);
+    _mm512_storeu_pd(to + 8 * i, out);
+  }
+}
+
 }  // namespace
+
+void corotated_forces_avx512(const CorotatedForcesInput& in, std::size_t begin, std::size_t end) {
+  const DoubleConstants constants;
+  for (std::size_t c = begin; c < end; ++c) cell_forces(in, constants, c);
+}
 
 void corotated_cells_avx512(const CorotatedCellsInputDouble& in, std::size_t begin, std::size_t end) {
   const DoubleConstants constants;
@@ -245,6 +296,7 @@ const bool kAvx512CellPassCompiled = false;
 
 void corotated_cells_avx512(const CorotatedCellsInput&, std::size_t, std::size_t) {}
 void corotated_cells_avx512(const CorotatedCellsInputDouble&, std::size_t, std::size_t) {}
+void corotated_forces_avx512(const CorotatedForcesInput&, std::size_t, std::size_t) {}
 
 }  // namespace cleave
 

@@ -47,6 +47,21 @@ struct CorotatedCellsInputDouble {
   double* per_cell = nullptr;
 };
 
+/// What the force pass reads and writes (fem/dynamics.hpp's internal forces): per cell
+/// R [K^e (R^T (X_e + x_e) - X_e) + T^e s], X_e the corners at rest relative to corner 0.
+struct CorotatedForcesInput {
+  const double* x = nullptr;                 ///< 3 per vertex: the displacement (plus a damping term), mm
+  const std::int32_t* corners = nullptr;     ///< 8 vertex ids per cell
+  const double* rotation = nullptr;          ///< 9 per cell: R column-major, R(i, j) at 3 j + i
+  const std::uint8_t* material = nullptr;    ///< per cell: its material slot
+  const double* stiffness_modes = nullptr;   ///< per material slot: K^e's 9 blocks in modes (corner_mode_form)
+  double cell_size_mm = 1.0;
+  /// T^e by component: [8 (3 k + i) + a] = T^e(3 a + i, k), 144 values (mm^2).
+  const double* stress_divergence = nullptr;
+  const double* stress = nullptr;            ///< 6 per cell (Voigt, kPa), or null (no stress)
+  double* per_cell = nullptr;                ///< out: 24 per cell, its corners' 8 x, 8 y, 8 z (mN)
+};
+
 /// The kernel below was compiled for AVX-512 (x86-64 with GCC or Clang); false elsewhere.
 extern const bool kAvx512CellPassCompiled;
 
@@ -58,5 +73,8 @@ bool avx512_cell_pass_supported();
 void corotated_cells_avx512(const CorotatedCellsInput& in, std::size_t begin, std::size_t end);
 /// The same in double, one cell per 8-double register (the CG's residual products).
 void corotated_cells_avx512(const CorotatedCellsInputDouble& in, std::size_t begin, std::size_t end);
+/// per_cell of cells [begin, end): the cells' corotated elastic and stress forces, one cell per
+/// 8-double register, in corner modes.
+void corotated_forces_avx512(const CorotatedForcesInput& in, std::size_t begin, std::size_t end);
 
 }  // namespace cleave

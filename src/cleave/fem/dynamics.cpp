@@ -77,6 +77,7 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
   }
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
   system_operator_.set_topology(model_.volume, table_);
+  force_pass_.set_topology(model_.volume, table_);
   update_rotations();
 }
 
@@ -161,32 +162,20 @@ std::vector<Vec3> Dynamics::displacement_mm() const {
 
 Vector Dynamics::internal_forces(const Vector* velocity) const {
   const LinkedVolume& volume = model_.volume;
-  const double h = table_.cell_size_mm;
   const double beta_k = velocity != nullptr ? settings_.stiffness_damping_s : 0.0;
   // Per cell its 24 corner forces by component (8 x, 8 y, 8 z), the layout of the operator's
   // corner slots; the buffer is kept across steps (8.8 MB at 45k cells: fresh pages each step
-  // cost more than the pass).
-  force_per_cell_.resize(24 * static_cast<std::size_t>(volume.cell_count()));
-  tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
-    for (CellId c = r.begin(); c != r.end(); ++c) {
-      const auto ci = static_cast<std::size_t>(c);
-      const Mat3& rot = rotations_[ci];
-      Vec24 d = corotated_displacement(cell_displacement(volume, c, u_), rot, h);
-      if (beta_k > 0) {
-        // K_R v on the cell = R K^e R^T v_e: the damping force shares K^e and R with the elastic one.
-        const Vec24 ve = cell_displacement(volume, c, *velocity);
-        for (int a = 0; a < kCornerCount; ++a) d.segment<3>(3 * a) += beta_k * (rot.transpose() * ve.segment<3>(3 * a));
-      }
-      // lazyProduct: unrolled in registers, not a GEMV call per cell.
-      Vec24 local = table_.of_label(volume.cell_label(c)).stiffness.lazyProduct(d);
-      if (!stress_kPa_.empty()) local += table_.stress_divergence.lazyProduct(stress_kPa_[ci]);
-      double* out = force_per_cell_.data() + 24 * ci;
-      for (int a = 0; a < kCornerCount; ++a) {
-        const Vec3 world = rot * local.segment<3>(3 * a);
-        for (int i = 0; i < 3; ++i) out[8 * i + a] = world[i];
-      }
-    }
-  });
+  // cost more than the pass). With stiffness damping, K_R v on the cell = R K^e R^T v_e shares
+  // K^e and R with the elastic force: the pass takes u + beta_k v.
+  const Vector* x = &u_;
+  if (beta_k > 0) {
+    damped_displacement_.resize(u_.size());
+    for_each_range(u_.size(), [&](Eigen::Index begin, Eigen::Index end) {
+      for (Eigen::Index i = begin; i < end; ++i) damped_displacement_[i] = u_[i] + beta_k * (*velocity)[i];
+    });
+    x = &damped_displacement_;
+  }
+  force_pass_.per_cell(rotations_, stress_kPa_, *x, force_per_cell_);
   // Summed per vertex over its corners (in parallel, without write conflicts).
   const VertexCornerSlots& slots = system_operator_.corner_slots();
   Vector f(u_.size());

@@ -41,6 +41,7 @@
 #include <string>
 #include <vector>
 
+#include "cleave/fem/corotated_forces.hpp"
 #include "cleave/fem/corotated_system_operator.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/model/tissue_model.hpp"
@@ -190,7 +191,9 @@ class Dynamics {
   BlockSparseMatrix<double> system_blocks_;
   VertexBlockGather gather_;                 ///< where each cell's blocks go in system_blocks_
   CorotatedSystemOperator system_operator_;  ///< the same system applied cell by cell
+  CorotatedForcePass force_pass_;            ///< the cells' elastic and stress forces
   mutable std::vector<double> force_per_cell_;  ///< internal_forces' per-cell corner forces (kept: no fresh pages per step)
+  mutable Vector damped_displacement_;          ///< u + beta_k v for the force pass (kept likewise)
   std::vector<std::int32_t> diagonal_block_;  ///< per vertex: its diagonal block in system_blocks_
   /// The same matrix as scalar CSR (vertex block pattern of the topology), made and filled from
   /// the blocks only when a solver asks for it (CHOLMOD, Eigen's CG, the assembled steps).
