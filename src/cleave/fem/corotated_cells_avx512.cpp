@@ -66,6 +66,21 @@ struct FloatConstants {
   __m512 sign[3] = {butterfly_signs(1), butterfly_signs(2), butterfly_signs(4)};
   __m512i swap_xz = swapping_bits(0, 2);
   __m512i swap_yz = swapping_bits(1, 2);
+  /// [single][k]: the permutes that spread R(k) (k = 3 j + i) of each cell over its half, from
+  /// [R_c, first 7 of R_{c+1}] and [last 2 of R_{c+1}] (single: R_c alone in both halves).
+  __m512i rotation_spread[2][9];
+  /// [single][q]: the permutes that spread t_q of each cell over its half, from [t_c, t_{c+1}].
+  __m512i tension_spread[2][6];
+  FloatConstants() {
+    for (int k = 0; k < 9; ++k) {
+      rotation_spread[0][k] = halves(k, 9 + k);
+      rotation_spread[1][k] = halves(k, k);
+    }
+    for (int q = 0; q < 6; ++q) {
+      tension_spread[0][q] = halves(q, 6 + q);
+      tension_spread[1][q] = halves(q, q);
+    }
+  }
 };
 struct DoubleConstants {
   __m512d sign[3] = {butterfly_signs_double(1), butterfly_signs_double(2), butterfly_signs_double(4)};
@@ -105,10 +120,7 @@ void cell_pair(const CorotatedCellsInput& in, const FloatConstants& constants, s
     // R_c (9 floats) and R_{c+1}'s first 7, then its last 2; a single cell reads only its own 9.
     const __m512 lower = _mm512_maskz_loadu_ps(single ? 0x1FF : 0xFFFF, in.rotation + 9 * c);
     const __m512 upper = _mm512_maskz_loadu_ps(single ? 0x0 : 0x3, in.rotation + 9 * c + 16);
-    for (int k = 0; k < 9; ++k) {
-      const int second = single ? k : 9 + k;  // lane of R_d(k) in [lower, upper]
-      rotation[k] = _mm512_permutex2var_ps(lower, halves(k, second), upper);
-    }
+    for (int k = 0; k < 9; ++k) rotation[k] = _mm512_permutex2var_ps(lower, constants.rotation_spread[single][k], upper);
   }
   // Into the cells' frames, d_i = sum_j R_ji x_j, and into modes.
   __m512 local[3];
@@ -141,7 +153,7 @@ void cell_pair(const CorotatedCellsInput& in, const FloatConstants& constants, s
     // shear parts on the pairs. t_q of each cell spread over its half (6 + 6 floats).
     const __m512 t = _mm512_maskz_loadu_ps(single ? 0x3F : 0xFFF, in.tension + 6 * c);
     __m512 spread[6];
-    for (int q = 0; q < 6; ++q) spread[q] = _mm512_permutexvar_ps(halves(q, single ? q : 6 + q), t);
+    for (int q = 0; q < 6; ++q) spread[q] = _mm512_permutexvar_ps(constants.tension_spread[single][q], t);
     __m512 g[6];
     for (std::size_t q = 0; q < 6; ++q) g[q] = _mm512_mul_ps(spread[q], _mm512_broadcast_f32x8(_mm256_loadu_ps(in.stress_modes + 8 * q)));
     const __m512 normal = _mm512_add_ps(g[0], _mm512_add_ps(g[1], g[2]));
