@@ -189,6 +189,42 @@ TEST(CorotatedSystemOperator, JacobiResidualInOnePassEqualsItFromTheAssembledSys
   }
 }
 
+// The Chebyshev step d = c_d d + c_z D^-1 (b - A x), x += d in one pass with the product's
+// per-vertex sum (x updated while the sum runs) equals the product, then a pass: in double and in
+// float, fixed dofs included; wrong sizes are refused.
+TEST(CorotatedSystemOperator, ChebyshevStepInOnePassEqualsTheProductThenAPass) {
+  const Fixture f;
+  const CorotatedSystemOperator op = f.op();
+  const std::vector<Mat3> inverse = op.inverse_diagonal_blocks();
+  const Vector b = 0.5 * probe(op.rows()).reverse();
+  const Vector x0 = probe(op.rows());
+  const Vector d0 = 0.01 * probe(op.rows()).cwiseAbs();
+  Vector x = x0, d = d0, work;
+  op.chebyshev_step(inverse, b, x, d, 0.3, 0.7, work);
+  Vector x_ref = x0, d_ref = d0;
+  op.VertexOperator::chebyshev_step(inverse, b, x_ref, d_ref, 0.3, 0.7, work);
+  const double scale = d_ref.lpNorm<Eigen::Infinity>();
+  ASSERT_GT(scale, 0.0);
+  EXPECT_LE((d - d_ref).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+  EXPECT_LE((x - x_ref).lpNorm<Eigen::Infinity>(), 1e-12 * x_ref.lpNorm<Eigen::Infinity>());
+  EXPECT_GT((x - x0).lpNorm<Eigen::Infinity>(), 0.1 * scale);  // it moved
+  std::vector<Mat3f> single(inverse.size());
+  for (std::size_t v = 0; v < inverse.size(); ++v) single[v] = inverse[v].cast<float>();
+  Eigen::VectorXf xs = x0.cast<float>(), ds = d0.cast<float>(), xs_ref = xs, ds_ref = ds, works;
+  const Eigen::VectorXf bs = b.cast<float>();
+  op.chebyshev_step(single, bs, xs, ds, 0.3f, 0.7f, works);
+  op.VertexOperator::chebyshev_step(single, bs, xs_ref, ds_ref, 0.3f, 0.7f, works);
+  EXPECT_LE((ds - ds_ref).cast<double>().lpNorm<Eigen::Infinity>(), 1e-6 * scale);
+  EXPECT_LE((ds.cast<double>() - d_ref).lpNorm<Eigen::Infinity>(), 1e-4 * scale);
+  try {
+    Eigen::VectorXd short_d = Vector::Zero(6);
+    op.chebyshev_step(inverse, b, x, short_d, 0.3, 0.7, work);
+    ADD_FAILURE() << "a short direction was taken";
+  } catch (const InputError& e) {
+    EXPECT_NE(std::string(e.what()).find("direction of 6"), std::string::npos) << e.what();
+  }
+}
+
 // The residual b - A x in one pass with the product's per-vertex sum equals it from the assembled
 // matrix (fixed dofs: b - x), in double and in float.
 TEST(CorotatedSystemOperator, ResidualInOnePassEqualsItFromTheAssembledSystem) {

@@ -338,6 +338,37 @@ void CorotatedSystemOperator::residual(const Eigen::VectorXd& b, const Eigen::Ve
   fused_residual(twin_, b, x, r);
 }
 
+template <typename Scalar>
+void CorotatedSystemOperator::fused_chebyshev_step(const Precision<Scalar>& p,
+                                                   const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                                                   const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
+                                                   Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& d,
+                                                   Scalar c_d, Scalar c_z) const {
+  if (b.size() != rows() || d.size() != rows() || static_cast<Eigen::Index>(3 * inverse_diagonal.size()) != rows())
+    throw InputError(fmt::format("corotated system: right-hand side of {} entries, direction of {} and {} diagonal blocks; expected "
+                                 "{}, {} and {}",
+                                 b.size(), d.size(), inverse_diagonal.size(), rows(), rows(), rows() / 3));
+  // x is read by the cell pass (done before any vertex is finished) and, at vertex v, by v's own
+  // sum (its mass term and fixed rows) before finish(v) writes it.
+  apply(p, x, [&](VertexId v, const Eigen::Matrix<Scalar, 3, 1>& ax) {
+    const auto i = 3 * static_cast<Eigen::Index>(v);
+    const Eigen::Matrix<Scalar, 3, 1> step =
+        c_d * d.template segment<3>(i) + c_z * (inverse_diagonal[static_cast<std::size_t>(v)] * (b.template segment<3>(i) - ax));
+    d.template segment<3>(i) = step;
+    x.template segment<3>(i) += step;
+  });
+}
+
+void CorotatedSystemOperator::chebyshev_step(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                                             Eigen::VectorXf& d, float c_d, float c_z, Eigen::VectorXf&) const {
+  fused_chebyshev_step(single_, inverse_diagonal, b, x, d, c_d, c_z);
+}
+
+void CorotatedSystemOperator::chebyshev_step(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                                             Eigen::VectorXd& d, double c_d, double c_z, Eigen::VectorXd&) const {
+  fused_chebyshev_step(twin_, inverse_diagonal, b, x, d, c_d, c_z);
+}
+
 void CorotatedSystemOperator::multiply(const Eigen::VectorXf& x, Eigen::VectorXf& y) const {
   y.resize(rows());
   apply(single_, x, [&](VertexId v, const Eigen::Vector3f& sum) { y.segment<3>(3 * static_cast<Eigen::Index>(v)) = sum; });

@@ -59,6 +59,12 @@ class CorotatedSystemOperator final : public VertexOperator {
                        Eigen::VectorXf& z) const override;
   void jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
                        Eigen::VectorXd& z) const override;
+  /// In one pass with the product's per-vertex sum: each vertex's x and d are updated once its
+  /// sum is complete (the cell pass, which reads x, is done by then).
+  void chebyshev_step(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, Eigen::VectorXf& x, Eigen::VectorXf& d,
+                      float c_d, float c_z, Eigen::VectorXf& work) const override;
+  void chebyshev_step(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, Eigen::VectorXd& x, Eigen::VectorXd& d,
+                      double c_d, double c_z, Eigen::VectorXd& work) const override;
   std::vector<Mat3> inverse_diagonal_blocks() const override;
   SparseMatrix assembled_matrix() const override;
   const std::vector<std::uint8_t>& fixed_dofs() const override { return *fixed_; }
@@ -108,6 +114,10 @@ class CorotatedSystemOperator final : public VertexOperator {
   template <typename Scalar, typename Finish>
   void sum_per_vertex(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_in,
                       const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x_masked, const Finish& finish) const;
+  template <typename Scalar>
+  void fused_chebyshev_step(const Precision<Scalar>& p, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                            const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                            Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& d, Scalar c_d, Scalar c_z) const;
   template <typename Scalar>
   void fused_residual(const Precision<Scalar>& p, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
                       const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) const;

@@ -53,6 +53,33 @@ void residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynami
   a.residual(b, x, r);
 }
 
+namespace {
+
+template <typename Scalar>
+void jacobi_then_step(const VertexOperator& a, const std::vector<Eigen::Matrix<Scalar, 3, 3>>& inverse_diagonal,
+                      const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x,
+                      Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& d, Scalar c_d, Scalar c_z, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& z) {
+  a.jacobi_residual(inverse_diagonal, b, x, z);
+  tbb::parallel_for(tbb::blocked_range<Eigen::Index>(0, z.size(), 3 * kVerticesPerTask), [&](const tbb::blocked_range<Eigen::Index>& r) {
+    const Eigen::Index n = r.end() - r.begin();
+    auto ds = d.segment(r.begin(), n);
+    ds = c_d * ds + c_z * z.segment(r.begin(), n);
+    x.segment(r.begin(), n) += ds;
+  });
+}
+
+}  // namespace
+
+void VertexOperator::chebyshev_step(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                                    Eigen::VectorXf& d, float c_d, float c_z, Eigen::VectorXf& work) const {
+  jacobi_then_step(*this, inverse_diagonal, b, x, d, c_d, c_z, work);
+}
+
+void VertexOperator::chebyshev_step(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                                    Eigen::VectorXd& d, double c_d, double c_z, Eigen::VectorXd& work) const {
+  jacobi_then_step(*this, inverse_diagonal, b, x, d, c_d, c_z, work);
+}
+
 void VertexOperator::jacobi_residual(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, const Eigen::VectorXf& x,
                                      Eigen::VectorXf& z) const {
   product_then_jacobi(*this, inverse_diagonal, b, x, z);

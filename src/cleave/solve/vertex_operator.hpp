@@ -9,6 +9,7 @@
 //   multiply(op, x, y);                 // y = A x       (float or double)
 //   residual(op, b, x, r);              // r = b - A x
 //   jacobi_residual(op, d_inv, b, x, z);  // z = D^-1 (b - A x)
+//   op.chebyshev_step(d_inv, b, x, d, c_d, c_z, work);  // d = c_d d + c_z D^-1 (b - A x); x += d
 //
 // Fixed dofs follow linear_solver.hpp: identity rows and zero columns.
 #include <cstdint>
@@ -45,6 +46,13 @@ class VertexOperator {
                                Eigen::VectorXf& z) const;
   virtual void jacobi_residual(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, const Eigen::VectorXd& x,
                                Eigen::VectorXd& z) const;
+  /// A Chebyshev smoothing step: d = c_d d + c_z D^-1 (b - A x), then x += d (d and x of the
+  /// operator's size; `work` may be used for D^-1 (b - A x)). By default jacobi_residual, then a
+  /// pass; an operator that sums its products per vertex may do both at once.
+  virtual void chebyshev_step(const std::vector<Mat3f>& inverse_diagonal, const Eigen::VectorXf& b, Eigen::VectorXf& x,
+                              Eigen::VectorXf& d, float c_d, float c_z, Eigen::VectorXf& work) const;
+  virtual void chebyshev_step(const std::vector<Mat3>& inverse_diagonal, const Eigen::VectorXd& b, Eigen::VectorXd& x,
+                              Eigen::VectorXd& d, double c_d, double c_z, Eigen::VectorXd& work) const;
 };
 
 template <typename Scalar>
