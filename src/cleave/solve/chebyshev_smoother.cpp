@@ -15,7 +15,9 @@ constexpr Eigen::Index kEntriesPerTask = 1 << 14;
 
 std::vector<Mat3f> single_precision(const std::vector<Mat3>& blocks) {
   std::vector<Mat3f> out(blocks.size());
-  for (std::size_t v = 0; v < out.size(); ++v) out[v] = blocks[v].cast<float>();
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks.size(), kEntriesPerTask / 3), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t v = r.begin(); v < r.end(); ++v) out[v] = blocks[v].cast<float>();
+  });
   return out;
 }
 
@@ -188,19 +190,22 @@ void ChebyshevSmoother::iterate(const Matrix& a, const Eigen::Matrix<Scalar, Eig
   const double sigma = theta / delta;
   double rho = 1.0 / sigma;
   const Eigen::Index n = b.size();
-  work.d.setZero(n);
   if (start == Start::from_zero) {
+    // x = d = D^-1 b / theta in one pass.
     x.resize(n);
-    work.z.resize(n);
+    work.d.resize(n);
+    const auto scale = static_cast<Scalar>(1.0 / theta);
     const auto blocks = static_cast<std::size_t>(n / 3);
     tbb::parallel_for(tbb::blocked_range<std::size_t>(0, blocks, kEntriesPerTask / 3), [&](const tbb::blocked_range<std::size_t>& r) {
       for (std::size_t v = r.begin(); v < r.end(); ++v) {
         const auto i = static_cast<Eigen::Index>(3 * v);
-        work.z.template segment<3>(i) = inverse[v] * b.template segment<3>(i);
+        const Eigen::Matrix<Scalar, 3, 1> step = scale * (inverse[v] * b.template segment<3>(i));
+        work.d.template segment<3>(i) = step;
+        x.template segment<3>(i) = step;
       }
     });
-    update_direction(Scalar{0}, static_cast<Scalar>(1.0 / theta), work.z, work.d, x, true);
   } else {
+    work.d.setZero(n);
     smoothing_step(a, inverse, b, x, work.d, Scalar{0}, static_cast<Scalar>(1.0 / theta), work.z);
   }
   for (int k = 1; k < options.degree; ++k) {
