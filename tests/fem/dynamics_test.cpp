@@ -320,7 +320,8 @@ TEST(Dynamics, PolarRotationsInLanesEqualTheOneAtATimeOnes) {
     }
     gradients.push_back(q * f);
   }
-  for (const std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{4}, std::size_t{7}, gradients.size()}) {
+  for (const std::size_t count : {std::size_t{1}, std::size_t{3}, std::size_t{4}, std::size_t{7}, std::size_t{8}, std::size_t{9},
+                                  std::size_t{16}, gradients.size()}) {
     std::vector<Mat3> rotations(count);
     rotations_from_deformation_gradients(std::span<const Mat3>(gradients.data(), count), rotations);
     for (std::size_t i = 0; i < count; ++i) {

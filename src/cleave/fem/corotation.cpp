@@ -13,7 +13,9 @@
 #include <limits>
 
 #include "cleave/core/error.hpp"
+#include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/hex8_element.hpp"
+#include "cleave/fem/polar_avx512.hpp"
 
 namespace cleave {
 
@@ -113,6 +115,17 @@ void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::
   if (gradients.size() != rotations.size())
     throw InputError(fmt::format("polar decomposition: {} deformation gradients but room for {} rotations", gradients.size(),
                                  rotations.size()));
+  static_assert(sizeof(Mat3) == 9 * sizeof(double));
+  if (avx512_cell_pass_supported()) {
+    const PolarIteration iteration{kNewtonMaxIterations, kNewtonSettled};
+    for (std::size_t i = 0; i < gradients.size(); i += 8) {
+      const int count = static_cast<int>(std::min<std::size_t>(8, gradients.size() - i));
+      const unsigned settled = polar_rotations_avx512(gradients[i].data(), rotations[i].data(), count, iteration);
+      for (int lane = 0; lane < count; ++lane)
+        if (((settled >> lane) & 1u) == 0) rotations[i + static_cast<std::size_t>(lane)] = rotation_by_svd(gradients[i + static_cast<std::size_t>(lane)]);
+    }
+    return;
+  }
   for (std::size_t i = 0; i < gradients.size(); i += kLanes) {
     const int count = static_cast<int>(std::min<std::size_t>(kLanes, gradients.size() - i));
     rotations_in_lanes(gradients.data() + i, rotations.data() + i, count);

@@ -18,13 +18,17 @@ namespace cleave {
 /// converges quadratically to the polar factor in about 4 iterations for tissue strains (2.6x
 /// faster than the SVD); the SVD otherwise, and where Newton does not settle.
 Mat3 rotation_from_deformation_gradient(const Mat3& deformation_gradient);
-/// rotation_from_deformation_gradient of each of `gradients` into `rotations` (as many), four at a
-/// time in SIMD lanes (the same Newton iteration, each lane stopping where it settles; lanes that
-/// go to the SVD are taken one by one): the same rotations to rounding, about 3x faster than one at
-/// a time (the cell passes of every dynamic step run it on all cells).
+/// rotation_from_deformation_gradient of each of `gradients` into `rotations` (as many), eight at
+/// a time in AVX-512 lanes where the CPU has them (fem/polar_avx512.hpp), else four in AVX2 lanes
+/// (the same Newton iteration, each lane stopping where it settles; lanes that go to the SVD are
+/// taken one by one): the same rotations to rounding, about 3x faster than one at a time with 4
+/// lanes (the cell passes of every dynamic step run it on all cells).
 void rotations_from_deformation_gradients(std::span<const Mat3> gradients, std::span<Mat3> rotations);
-/// How many gradients rotations_from_deformation_gradients takes at once (one AVX2 register of doubles).
+/// How many gradients the AVX2 lanes take at once (one register of doubles).
 inline constexpr int kPolarLanes = 4;
+/// How many gradients the cell passes hand to rotations_from_deformation_gradients at once (the
+/// AVX-512 lanes, or two groups of AVX2 lanes).
+inline constexpr int kPolarBatch = 8;
 /// The same by the SVD alone (the reference the Newton iteration is tested against). A gradient
 /// with a non-finite entry has no rotation: all NaN, from either function (the step that made it
 /// then reports its non-finite displacement).
@@ -51,7 +55,7 @@ Vec24 corotated_displacement(const Vec24& cell_displacement_mm, const Mat3& rota
 template <typename Each>
 void cell_frames_in_range(const LinkedVolume& volume, const Vector& displacement_mm, CellId begin, CellId end,
                           std::vector<Mat3>& rotations, Each&& each) {
-  constexpr CellId kBatch = kPolarLanes;
+  constexpr CellId kBatch = kPolarBatch;
   const double h = volume.grid().cell_size_mm;
   std::array<Mat3, kBatch> gradients;
   for (CellId first = begin; first < end; first += kBatch) {
