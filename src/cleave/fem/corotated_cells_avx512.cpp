@@ -198,21 +198,39 @@ void stiffness_in_modes(const double* k, const DoubleConstants& constants, const
   f[2] = _mm512_fmadd_pd(coefficient(7), by_yz[1], _mm512_fmadd_pd(coefficient(6), by_xz[0], _mm512_mul_pd(coefficient(8), local[2])));
 }
 
-/// Cell c in double: lanes are its 8 corners (modes, once transformed).
-void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& constants, std::size_t c) {
-  const __m256i offsets =
-      _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.corners + 8 * c)), _mm256_set1_epi32(3));
-  __m512d world[3];
-  for (int j = 0; j < 3; ++j) world[j] = _mm512_i32gather_pd(offsets, in.x + j, 8);
-  const double* r = in.rotation + 9 * c;  // R(i, j) at 3 j + i
-  // Into the cell's frame, d_i = sum_j R_ji x_j, and into modes.
-  __m512d local[3];
+/// The corners' x, y, z (world) of the cell whose 8 vertex ids are `corners`, from `x` (3 per vertex).
+void gather_corners(const std::int32_t* corners, const double* x, __m512d world[3]) {
+  const __m256i offsets = _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(corners)), _mm256_set1_epi32(3));
+  for (int j = 0; j < 3; ++j) world[j] = _mm512_i32gather_pd(offsets, x + j, 8);
+}
+
+/// Into the cell's frame, d_i = sum_j R_ji w_j (r: R column-major, R(i, j) at 3 j + i).
+void to_cell_frame(const double* r, const __m512d world[3], __m512d local[3]) {
   for (int i = 0; i < 3; ++i) {
     local[i] = _mm512_mul_pd(_mm512_set1_pd(r[3 * i + 0]), world[0]);
     local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 1]), world[1], local[i]);
     local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
-    local[i] = corner_modes(local[i], constants);
   }
+}
+
+/// Back into the world, out_i = sum_j R_ij f_j, stored as the cell's 8 x, 8 y, 8 z at `to`.
+void store_in_world(const double* r, const __m512d f[3], double* to) {
+  for (int i = 0; i < 3; ++i) {
+    __m512d out = _mm512_mul_pd(_mm512_set1_pd(r[i]), f[0]);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[3 + i]), f[1], out);
+    out = _mm512_fmadd_pd(_mm512_set1_pd(r[6 + i]), f[2], out);
+    _mm512_storeu_pd(to + 8 * i, out);
+  }
+}
+
+/// Cell c in double: lanes are its 8 corners (modes, once transformed).
+void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& constants, std::size_t c) {
+  __m512d world[3];
+  gather_corners(in.corners + 8 * c, in.x, world);
+  const double* r = in.rotation + 9 * c;
+  __m512d local[3];
+  to_cell_frame(r, world, local);
+  for (int i = 0; i < 3; ++i) local[i] = corner_modes(local[i], constants);
   __m512d by_xy[3], by_xz[3], by_yz[3];
   __m512d f[3];
   stiffness_in_modes(in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]), constants, local, by_xy, by_xz, by_yz, f);
@@ -229,36 +247,24 @@ void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& con
     }
   }
   for (int i = 0; i < 3; ++i) f[i] = corner_modes(f[i], constants);
-  // Back into the world: out_i = sum_j R_ij f_j.
-  double* to = in.per_cell + 24 * c;
-  for (int i = 0; i < 3; ++i) {
-    __m512d out = _mm512_mul_pd(_mm512_set1_pd(r[i]), f[0]);
-    out = _mm512_fmadd_pd(_mm512_set1_pd(r[3 + i]), f[1], out);
-    out = _mm512_fmadd_pd(_mm512_set1_pd(r[6 + i]), f[2], out);
-    _mm512_storeu_pd(to + 8 * i, out);
-  }
+  store_in_world(r, f, in.per_cell + 24 * c);
 }
 
 
 /// Cell c's elastic and stress forces in double: R [K^e (R^T (X_e + x_e) - X_e) + T^e s].
 void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constants, std::size_t c) {
-  const __m256i offsets =
-      _mm256_mullo_epi32(_mm256_loadu_si256(reinterpret_cast<const __m256i*>(in.corners + 8 * c)), _mm256_set1_epi32(3));
   // The corners' positions relative to corner 0 at rest, h (a_x, a_y, a_z), plus their displacement.
   __m512d rest[3];
   for (int j = 0; j < 3; ++j) rest[j] = _mm512_mul_pd(_mm512_set1_pd(0.5 * in.cell_size_mm), _mm512_sub_pd(_mm512_set1_pd(1.0), constants.sign[j]));
   __m512d world[3];
-  for (int j = 0; j < 3; ++j) world[j] = _mm512_add_pd(rest[j], _mm512_i32gather_pd(offsets, in.x + j, 8));
-  const double* r = in.rotation + 9 * c;  // R(i, j) at 3 j + i
+  gather_corners(in.corners + 8 * c, in.x, world);
+  for (int j = 0; j < 3; ++j) world[j] = _mm512_add_pd(rest[j], world[j]);
+  const double* r = in.rotation + 9 * c;
   // d_i = sum_j R_ji (X + x)_j - X_i in the cell's frame, into modes (the rigid translation, mode
   // 0, has no stiffness: no need to take corner 0's displacement off).
   __m512d local[3];
-  for (int i = 0; i < 3; ++i) {
-    local[i] = _mm512_mul_pd(_mm512_set1_pd(r[3 * i + 0]), world[0]);
-    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 1]), world[1], local[i]);
-    local[i] = _mm512_fmadd_pd(_mm512_set1_pd(r[3 * i + 2]), world[2], local[i]);
-    local[i] = corner_modes(_mm512_sub_pd(local[i], rest[i]), constants);
-  }
+  to_cell_frame(r, world, local);
+  for (int i = 0; i < 3; ++i) local[i] = corner_modes(_mm512_sub_pd(local[i], rest[i]), constants);
   __m512d by_xy[3], by_xz[3], by_yz[3];
   __m512d f[3];
   stiffness_in_modes(in.stiffness_modes + 72 * static_cast<std::size_t>(in.material[c]), constants, local, by_xy, by_xz, by_yz, f);
@@ -270,13 +276,7 @@ void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constant
       for (int k = 0; k < 6; ++k)
         f[i] = _mm512_fmadd_pd(_mm512_set1_pd(s[k]), _mm512_loadu_pd(in.stress_divergence + 8 * (3 * k + i)), f[i]);
   }
-  double* to = in.per_cell + 24 * c;
-  for (int i = 0; i < 3; ++i) {
-    __m512d out = _mm512_mul_pd(_mm512_set1_pd(r[i]), f[0]);
-    out = _mm512_fmadd_pd(_mm512_set1_pd(r[3 + i]), f[1], out);
-    out = _mm512_fmadd_pd(_mm512_set1_pd(r[6 + i]), f[2], out);
-    _mm512_storeu_pd(to + 8 * i, out);
-  }
+  store_in_world(r, f, in.per_cell + 24 * c);
 }
 
 }  // namespace
