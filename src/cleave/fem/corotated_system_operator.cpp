@@ -2,9 +2,6 @@
 
 #include <fmt/format.h>
 #include <algorithm>
-#include <chrono>
-#include <cstdio>
-#include <cstdlib>
 #include <type_traits>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
@@ -209,16 +206,9 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       in.stress_modes = p.stress_modes.data();
       in.tension = with_tension_ ? p.tension.front().data() : nullptr;
       in.per_cell = p.per_cell.data();
-      auto t0=std::chrono::steady_clock::now();
       tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
                         [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
-      auto t1=std::chrono::steady_clock::now();
       sum_per_vertex(p, x_in, *x, finish);
-      auto t2=std::chrono::steady_clock::now();
-      static double a=0,b=0; static long n=0; a+=std::chrono::duration<double,std::milli>(t1-t0).count(); b+=std::chrono::duration<double,std::milli>(t2-t1).count();
-      if(++n%100==0) std::fprintf(stderr,"cells %.3f sum %.3f\n",a/n,b/n);
-      if (std::getenv("SERIAL")) { auto s0=std::chrono::steady_clock::now(); for(int rep=0;rep<10;++rep) corotated_cells_avx512(in, 0, cells); auto s1=std::chrono::steady_clock::now(); std::fprintf(stderr,"serial %.3f\n",std::chrono::duration<double,std::milli>(s1-s0).count()/10);
-        s0=std::chrono::steady_clock::now(); for(int rep=0;rep<220;++rep) corotated_cells_avx512(in, 0, 2000); s1=std::chrono::steady_clock::now(); std::fprintf(stderr,"cached serial (scaled to all cells) %.3f\n",std::chrono::duration<double,std::milli>(s1-s0).count()/10);}
       return;
     }
   } else if (mode_cell_pass() && cells > 0) {

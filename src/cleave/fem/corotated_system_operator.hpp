@@ -11,10 +11,10 @@
 // passes work in corner modes (fem/cube_corner_modes.hpp), where each 8 x 8 block of K^e and of
 // the stress stiffness is a multiply and a lane permutation: float two cells per 16-float
 // register, double one cell per 8-double register (fem/corotated_cells_avx512.hpp), reading the
-// cell's 6 tension values. At 44k cells the double product takes 1.1 ms instead of 1.3 (dense
-// blocks) and the float 0.75 ms (as the dense AVX-512 pass: gathers and permutations bound it),
-// against 1.1 ms for the portable pass, which reads an 8 x 8 stress stiffness per cell formed
-// once per state.
+// cell's 6 tension values. At 44k cells (session 35) the double product takes 1.1-1.25 ms
+// instead of 1.3-1.5 with the dense blocks, the float one 0.6 ms instead of 0.75-0.8 (its gathers
+// and permutations bind it, not its multiply-adds), against 0.9-1.1 ms for the portable pass,
+// which reads an 8 x 8 stress stiffness per cell formed once per state.
 //
 //   CorotatedSystemOperator op;
 //   op.set_topology(volume, table);                  // after construction and after every cut
