@@ -39,25 +39,24 @@ __m512d butterfly_signs_double(int bit) {
   return _mm512_load_pd(signs);
 }
 
+/// `mode` (0-7) with its bits `first` and `second` swapped (paired_mode of
+/// fem/cube_corner_modes.hpp, which this file cannot include).
+int bits_swapped(int mode, int first, int second) {
+  const int a = (mode >> first) & 1;
+  const int b = (mode >> second) & 1;
+  return (mode & ~((1 << first) | (1 << second))) | (a << second) | (b << first);
+}
+
 /// Lane permutations within each 8-lane half that swap two bits of the lane index (the mode
-/// pairings of fem/cube_corner_modes.hpp): [0, 2, 1, 3, ...] for bits 0 and 1, and so on.
+/// pairings): [0, 2, 1, 3, ...] for bits 0 and 1, and so on.
 __m512i swapping_bits(int first, int second) {
   alignas(64) std::int32_t index[16];
-  for (int lane = 0; lane < 16; ++lane) {
-    const int m = lane & 7;
-    const int a = (m >> first) & 1;
-    const int b = (m >> second) & 1;
-    index[lane] = (lane & 8) | (m & ~((1 << first) | (1 << second))) | (a << second) | (b << first);
-  }
+  for (int lane = 0; lane < 16; ++lane) index[lane] = (lane & 8) | bits_swapped(lane & 7, first, second);
   return _mm512_load_si512(index);
 }
 __m512i swapping_bits_double(int first, int second) {
   alignas(64) std::int64_t index[8];
-  for (int m = 0; m < 8; ++m) {
-    const int a = (m >> first) & 1;
-    const int b = (m >> second) & 1;
-    index[m] = (m & ~((1 << first) | (1 << second))) | (a << second) | (b << first);
-  }
+  for (int m = 0; m < 8; ++m) index[m] = bits_swapped(m, first, second);
   return _mm512_load_si512(index);
 }
 
@@ -250,12 +249,10 @@ void cell_double(const CorotatedCellsInputDouble& in, const DoubleConstants& con
   store_in_world(r, f, in.per_cell + 24 * c);
 }
 
-
 /// Cell c's elastic and stress forces in double: R [K^e (R^T (X_e + x_e) - X_e) + T^e s].
-void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constants, std::size_t c) {
-  // The corners' positions relative to corner 0 at rest, h (a_x, a_y, a_z), plus their displacement.
-  __m512d rest[3];
-  for (int j = 0; j < 3; ++j) rest[j] = _mm512_mul_pd(_mm512_set1_pd(0.5 * in.cell_size_mm), _mm512_sub_pd(_mm512_set1_pd(1.0), constants.sign[j]));
+/// `rest`: the corners' positions relative to corner 0 at rest, h (a_x, a_y, a_z).
+void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constants, const __m512d rest[3], std::size_t c) {
+  // The rest positions plus the displacement.
   __m512d world[3];
   gather_corners(in.corners + 8 * c, in.x, world);
   for (int j = 0; j < 3; ++j) world[j] = _mm512_add_pd(rest[j], world[j]);
@@ -283,7 +280,11 @@ void cell_forces(const CorotatedForcesInput& in, const DoubleConstants& constant
 
 void corotated_forces_avx512(const CorotatedForcesInput& in, std::size_t begin, std::size_t end) {
   const DoubleConstants constants;
-  for (std::size_t c = begin; c < end; ++c) cell_forces(in, constants, c);
+  // h (a_x, a_y, a_z) per corner a: h (1 - sign) / 2 with the butterflies' signs.
+  __m512d rest[3];
+  for (int j = 0; j < 3; ++j)
+    rest[j] = _mm512_mul_pd(_mm512_set1_pd(0.5 * in.cell_size_mm), _mm512_sub_pd(_mm512_set1_pd(1.0), constants.sign[j]));
+  for (std::size_t c = begin; c < end; ++c) cell_forces(in, constants, rest, c);
 }
 
 void corotated_cells_avx512(const CorotatedCellsInputDouble& in, std::size_t begin, std::size_t end) {

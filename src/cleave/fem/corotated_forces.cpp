@@ -19,9 +19,7 @@ constexpr CellId kCellsPerTask = 512;
 void CorotatedForcePass::set_topology(const LinkedVolume& volume, const ElementTable& table) {
   volume_ = &volume;
   table_ = &table;
-  const auto cells = static_cast<std::size_t>(volume.cell_count());
-  material_.resize(cells);
-  for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
+  material_ = material_slot_per_cell(table, volume);
   stiffness_modes_.clear();
   modes_available_ = avx512_cell_pass_supported();
   for (const ElementMatrices& material : table.per_material) {

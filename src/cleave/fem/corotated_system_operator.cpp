@@ -53,9 +53,7 @@ bool avx512_cell_pass_supported() {
 void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const ElementTable& table) {
   volume_ = &volume;
   table_ = &table;
-  const auto cells = static_cast<std::size_t>(volume.cell_count());
-  material_.resize(cells);
-  for (std::size_t c = 0; c < cells; ++c) material_[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
+  material_ = material_slot_per_cell(table, volume);
   corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
   // The element matrices in corner modes, for the AVX-512 passes (none: the portable pass).

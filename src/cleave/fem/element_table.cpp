@@ -26,4 +26,11 @@ ElementTable make_element_table(const TissueModel& model) {
   return table;
 }
 
+std::vector<std::uint8_t> material_slot_per_cell(const ElementTable& table, const LinkedVolume& volume) {
+  std::vector<std::uint8_t> slots(static_cast<std::size_t>(volume.cell_count()));
+  for (std::size_t c = 0; c < slots.size(); ++c)
+    slots[c] = static_cast<std::uint8_t>(table.slot_of_label[volume.cell_label(static_cast<CellId>(c))]);
+  return slots;
+}
+
 }  // namespace cleave

@@ -8,6 +8,7 @@
 //
 // Units: K^e in mN/mm, T^e in mm^2, node mass in kg (lumped: rho h^3 / 8 per corner).
 #include <array>
+#include <cstdint>
 #include <vector>
 
 #include "cleave/fem/hex8_element.hpp"
@@ -32,6 +33,9 @@ struct ElementTable {
     return per_material[static_cast<std::size_t>(slot_of_label[label])];
   }
 };
+
+/// Per cell of `volume`: its material's slot in table.per_material (the cell passes' lookup).
+std::vector<std::uint8_t> material_slot_per_cell(const ElementTable& table, const LinkedVolume& volume);
 
 /// Element matrices for every label used by a cell of `model`. Materials are validated
 /// (InputError naming "materials/<label>" for E <= 0, nu outside (-1, 0.5), density <= 0).

@@ -8,10 +8,6 @@ namespace {
 
 constexpr std::size_t kVerticesPerTask = 2048;
 
-}  // namespace
-
-namespace {
-
 template <typename Scalar>
 void product_then_residual(const VertexOperator& a, const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& b,
                            const Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& x, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& r) {
