@@ -42,7 +42,7 @@ const CommandRegistrar kStudio{
        cmd->add_option("--max-send-queue-mb", args->options.max_send_queue_mb,
                        "disconnect a client whose unsent messages pass this many MB (one that stopped reading)")
            ->capture_default_str()
-           ->check(CLI::Range(1, 65536));
+           ->check(CLI::Range(0.01, 65536.0));
        return [args] { return run_studio(*args); };
      }}};
 

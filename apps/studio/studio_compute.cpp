@@ -81,16 +81,16 @@ std::vector<std::uint32_t> visible_triangles(const RenderSurface& surface, const
 
 }  // namespace
 
-StudioCompute::StudioCompute(const StudioSession& session, std::function<void(std::string)> send, FieldWorker::JobThread jobs)
+StudioCompute::StudioCompute(const StudioSession& session, Send send, FieldWorker::JobThread jobs)
     : session_(session), send_(std::move(send)) {
   std::random_device entropy;
   server_token_ = fmt::format("{:08x}{:08x}", entropy(), entropy());
   worker_ = std::make_unique<FieldWorker>(
       [this](FieldWorker::Result r) {
         if (r.message.value("type", "") == "result") publish_result(std::move(r.message));
-        else send_(wire_encoded(r.message));
+        else send_(wire_encoded(r.message), BroadcastKind::every);
       },
-      [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump()); }, jobs);
+      [this](nlohmann::json progress) { send_(checked_outgoing(std::move(progress)).dump(), BroadcastKind::every); }, jobs);
 }
 
 void StudioCompute::publish_result(nlohmann::json message) {
@@ -101,8 +101,9 @@ void StudioCompute::publish_result(nlohmann::json message) {
                              {"skipped", worker_->jobs_skipped()},
                              {"published", ++results_published_}};
   // The connected clients hold the parts of the surface they were last sent that are made with
-  // it (every result reaches every client; one that connects later gets latest_result_ in full):
-  // a result on that surface goes out without them.
+  // it (every client gets every result or a newer one in its place, never a partial one in place
+  // of a full one: broadcast_kind.hpp; one that connects later gets latest_result_ in full): a
+  // result on that surface goes out without them.
   static const std::array<nlohmann::json::json_pointer, 2> kSurfaceParts = {nlohmann::json::json_pointer("/surface/triangles"),
                                                                             nlohmann::json::json_pointer("/fields/cut_depth")};
   std::vector<std::pair<const nlohmann::json::json_pointer*, nlohmann::json>> held;
@@ -117,12 +118,13 @@ void StudioCompute::publish_result(nlohmann::json message) {
     broadcast_surface_id_ = id;
   }
   std::string text = wire_encoded(message);
+  const BroadcastKind kind = held.empty() ? BroadcastKind::full_result : BroadcastKind::partial_result;
   for (auto& [part, value] : held) message[*part] = std::move(value);
   {
     std::lock_guard lock(latest_mutex_);
     latest_result_ = std::move(message);
   }
-  send_(std::move(text));
+  send_(std::move(text), kind);
 }
 
 StudioCompute::~StudioCompute() { worker_.reset(); }
@@ -317,7 +319,7 @@ void StudioCompute::stream_opening(const DesignState& design, std::uint64_t gene
     frame["step_iterations"] = step.iterations;
     if (step.initial_relative_residual > 0) frame["step_residual"] = step.relative_residual / step.initial_relative_residual;
     frame = checked_outgoing(std::move(frame));
-    send_(wire_encoded(frame));
+    send_(wire_encoded(frame), BroadcastKind::frame);
     if (frame["type"] == "error") return;  // the statics after it report the result (or its error)
   }
   timings["opening"] = ms_since(t0);

@@ -22,6 +22,7 @@
 #include "cleave/surface/surface_mesh.hpp"
 #include "cleave/viz/incision_ellipses.hpp"
 #include "studio/cut_face_values.hpp"
+#include "studio/broadcast_kind.hpp"
 #include "studio/field_worker.hpp"
 #include "studio/message_handler.hpp"
 #include "studio/studio_session.hpp"
@@ -31,10 +32,12 @@ namespace cleave::studio {
 class StudioCompute {
  public:
   /// `send` delivers a message to every client (thread safe; called from the worker thread):
-  /// JSON text, or the binary form of wire_message.hpp for results and frames.
+  /// JSON text, or the binary form of wire_message.hpp for results and frames; its kind says
+  /// which unsent message it may replace (broadcast_kind.hpp).
   /// `jobs`: where the computations run (FieldWorker::JobThread; `cleave studio`: its main
   /// thread, through run_jobs()).
-  StudioCompute(const StudioSession& session, std::function<void(std::string)> send,
+  using Send = std::function<void(std::string, BroadcastKind)>;
+  StudioCompute(const StudioSession& session, Send send,
                 FieldWorker::JobThread jobs = FieldWorker::JobThread::own);
   ~StudioCompute();
 
@@ -124,7 +127,7 @@ class StudioCompute {
   std::vector<std::future<std::unique_ptr<StaticSolver>>> abandoned_statics_;
 
   const StudioSession& session_;
-  std::function<void(std::string)> send_;
+  Send send_;
   /// What the latest result exports (shared with the I/O thread under latest_mutex_).
   struct ExportSnapshot {
     std::shared_ptr<const TissueModel> model;  ///< cut

@@ -45,7 +45,7 @@ int run_studio(const StudioMainOptions& options) {
   ServerOptions server_options;
   server_options.bind_address = checked_bind_address(options.host, options.host_origin);
   server_options.port = options.port;
-  server_options.max_queued_bytes = options.max_send_queue_mb << 20;
+  server_options.max_queued_bytes = static_cast<std::size_t>(options.max_send_queue_mb * (1 << 20));
   server_options.web_root = std::filesystem::absolute(options.web_root);
   if (!std::filesystem::is_regular_file(server_options.web_root / "index.html"))
     throw InputError(fmt::format("--web-root '{}' has no index.html", options.web_root.string()));
@@ -59,8 +59,8 @@ int run_studio(const StudioMainOptions& options) {
   // FieldWorker::JobThread for why.
   StudioCompute compute(
       session,
-      [&server](std::string text) {
-        if (server) server->broadcast(std::move(text));
+      [&server](std::string text, BroadcastKind kind) {
+        if (server) server->broadcast(std::move(text), kind);
       },
       FieldWorker::JobThread::caller);
   ServerHooks hooks;

@@ -19,7 +19,7 @@ struct StudioMainOptions {
   HostOrigin host_origin = HostOrigin::default_loopback;
   std::filesystem::path session_folder = "cleave-session";
   std::filesystem::path web_root = CLEAVE_WEB_ROOT;
-  std::size_t max_send_queue_mb = kDefaultMaxQueuedBytes >> 20;  ///< a client whose unsent messages pass this is disconnected
+  double max_send_queue_mb = static_cast<double>(kDefaultMaxQueuedBytes >> 20);  ///< a client whose unsent messages pass this is disconnected
   std::optional<nlohmann::json> case_document;  ///< nullopt: the session folder's model or the default
 };
 

@@ -6,6 +6,7 @@
 #include <boost/beast/core.hpp>
 #include <boost/beast/http.hpp>
 #include <boost/beast/websocket.hpp>
+#include <cstdio>
 #include <deque>
 #include <fmt/format.h>
 #include <set>
@@ -60,7 +61,7 @@ struct StudioServer::Impl {
 
   Impl(StudioSession& s, ServerOptions o, ServerHooks h) : session(s), options(std::move(o)), hooks(std::move(h)) {}
   void accept();
-  void broadcast_now(const std::shared_ptr<const std::string>& text);
+  void broadcast_now(const std::shared_ptr<const std::string>& text, BroadcastKind kind);
   /// The state after an edit, to every client (WsClient::send_state).
   void broadcast_state(const std::shared_ptr<const std::string>& text);
   nlohmann::json handle_text(const std::string& text, bool& design_changed);
@@ -86,27 +87,33 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     });
   }
 
-  void send(std::shared_ptr<const std::string> text) { enqueue(std::move(text), false); }
+  /// The kinds of queued message a newer one may replace while unsent.
+  enum class Kind { plain, frame, state, full_result, partial_result };
+
+  void send(std::shared_ptr<const std::string> text) { enqueue(std::move(text), Kind::plain); }
 
   /// A broadcast "state" (the whole design after an edit): only the newest matters, so one still
   /// waiting in the queue (not the one being written) is replaced by it in place. It stays ahead
   /// of the sender's acknowledgement, which is queued after it; a client that reads slowly during
   /// a burst of edits from other clients holds one state, not one per edit.
-  void send_state(std::shared_ptr<const std::string> text) {
-    if (closed_) return;
-    for (std::size_t i = queue_.size(); i-- > 1;) {  // queue_[0] is being written
-      if (!queue_[i].state) continue;
-      queued_bytes_ = queued_bytes_ - queue_[i].text->size() + text->size();
-      queue_[i].text = std::move(text);
-      return;
+  void send_state(std::shared_ptr<const std::string> text) { enqueue_replacing(std::move(text), Kind::state); }
+
+  /// A broadcast result or message of another kind (broadcast_kind.hpp).
+  void send_broadcast(std::shared_ptr<const std::string> text, BroadcastKind kind) {
+    switch (kind) {
+      case BroadcastKind::every: return send(std::move(text));
+      case BroadcastKind::frame: return enqueue(std::move(text), Kind::frame);
+      case BroadcastKind::full_result: return enqueue_replacing(std::move(text), Kind::full_result);
+      case BroadcastKind::partial_result: return enqueue_replacing(std::move(text), Kind::partial_result);
     }
-    enqueue(std::move(text), true);
   }
 
  private:
   void read() {
     ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
       if (ec) {
+        if (ec != websocket::error::closed && ec != net::error::eof && ec != net::error::operation_aborted)
+          fmt::print(stderr, "cleave studio: a client's connection ended: {}\n", ec.message());
         self->close();
         return;
       }
@@ -126,22 +133,48 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
         self->send(std::make_shared<const std::string>(reply.dump()));
         if (is_hello && self->server_.hooks.welcome_messages)
           for (std::string& m : self->server_.hooks.welcome_messages())
-            self->send(std::make_shared<const std::string>(std::move(m)));
+            self->enqueue_replacing(std::make_shared<const std::string>(std::move(m)), Kind::full_result);
         if (design_changed && self->server_.hooks.design_changed) self->server_.hooks.design_changed(self->server_.session);
       }
       self->read();
     });
   }
 
-  void enqueue(std::shared_ptr<const std::string> text, bool state) {
+  static bool is_result(Kind kind) { return kind == Kind::full_result || kind == Kind::partial_result; }
+
+  /// Replaces the newest unsent message of `kind`'s family in place (a state any state; a full
+  /// result any result queued after the last frame; a partial result only a partial one), else
+  /// queues `text`.
+  void enqueue_replacing(std::shared_ptr<const std::string> text, Kind kind) {
     if (closed_) return;
-    // A client that does not read: drop it before its queue holds every result since.
-    if (queue_.size() >= kMaxQueuedMessages || queued_bytes_ + text->size() > server_.options.max_queued_bytes) {
+    for (std::size_t i = queue_.size(); i-- > 1;) {  // queue_[0] is being written
+      Queued& queued = queue_[i];
+      if (is_result(kind) && queued.kind == Kind::frame) break;
+      const bool same_family = kind == Kind::state ? queued.kind == Kind::state : is_result(queued.kind);
+      if (!same_family) continue;
+      if (kind == Kind::partial_result && queued.kind != Kind::partial_result) break;
+      queued_bytes_ = queued_bytes_ - queued.text->size() + text->size();
+      queued.text = std::move(text);
+      queued.kind = kind;
+      return;
+    }
+    enqueue(std::move(text), kind);
+  }
+
+  void enqueue(std::shared_ptr<const std::string> text, Kind kind) {
+    if (closed_) return;
+    // A client that does not read: drop it before its queue holds everything since. One message
+    // alone is never a backlog, whatever its size.
+    if (queue_.size() >= kMaxQueuedMessages ||
+        (!queue_.empty() && queued_bytes_ + text->size() > server_.options.max_queued_bytes)) {
+      fmt::print(stderr, "cleave studio: a client was disconnected: its send queue held {} messages, {:.1f} MiB (limits {}, {} MiB)\n",
+                 queue_.size(), static_cast<double>(queued_bytes_ + text->size()) / (1 << 20), kMaxQueuedMessages,
+                 server_.options.max_queued_bytes >> 20);
       close();
       return;
     }
     queued_bytes_ += text->size();
-    queue_.push_back({std::move(text), state});
+    queue_.push_back({std::move(text), kind});
     if (queue_.size() == 1) write_next();
   }
 
@@ -176,7 +209,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   beast::flat_buffer buffer_;
   struct Queued {
     std::shared_ptr<const std::string> text;
-    bool state = false;  ///< a broadcast state, which a newer one replaces while unsent
+    Kind kind = Kind::plain;  ///< what a newer message may replace it by while unsent
   };
   std::deque<Queued> queue_;
   std::size_t queued_bytes_ = 0;  ///< of the messages in queue_ (the one being written included)
@@ -299,9 +332,9 @@ void StudioServer::Impl::accept() {
   });
 }
 
-void StudioServer::Impl::broadcast_now(const std::shared_ptr<const std::string>& text) {
-  const auto copy = clients;  // send() may drop a client from the set
-  for (const auto& c : copy) c->send(text);
+void StudioServer::Impl::broadcast_now(const std::shared_ptr<const std::string>& text, BroadcastKind kind) {
+  const auto copy = clients;  // sending may drop a client from the set
+  for (const auto& c : copy) c->send_broadcast(text, kind);
 }
 
 void StudioServer::Impl::broadcast_state(const std::shared_ptr<const std::string>& text) {
@@ -364,9 +397,9 @@ void StudioServer::stop() {
   net::post(impl_->io, [this] { impl_->io.stop(); });
 }
 
-void StudioServer::broadcast(std::string text) {
+void StudioServer::broadcast(std::string text, BroadcastKind kind) {
   auto shared = std::make_shared<const std::string>(std::move(text));
-  net::post(impl_->io, [this, shared] { impl_->broadcast_now(shared); });
+  net::post(impl_->io, [this, shared, kind] { impl_->broadcast_now(shared, kind); });
 }
 
 }  // namespace cleave::studio

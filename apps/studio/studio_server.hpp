@@ -12,10 +12,12 @@
 //                              "state" (after every edit, to every client), "mesh", "result",
 //                              "progress" and "frame" messages (docs/studio.md)
 // Limits: request headers 8 KiB, bodies kMaxHttpBodyBytes, WebSocket messages kMaxMessageBytes;
-// a client whose send queue exceeds kMaxQueuedMessages messages or ServerOptions::max_queued_bytes
-// (a client that stopped reading: results at 45k cells are ~2.5 MB each) is disconnected; the
+// a client whose send queue exceeds kMaxQueuedMessages messages or, with more than one message,
+// ServerOptions::max_queued_bytes (a client that stopped reading: results at 45k cells are ~2.5 MB
+// each) is disconnected; the
 // others go on. A broadcast state still unsent to a client is replaced by a newer one (only the
-// newest design matters), so a burst of edits by other clients does not fill a slow reader's queue.
+// newest design matters), and so is a result (broadcast_kind.hpp), so a burst of edits does not
+// fill a slow reader's queue.
 #include <cstdint>
 #include <filesystem>
 #include <functional>
@@ -23,6 +25,7 @@
 #include <nlohmann/json.hpp>
 #include <string>
 
+#include "studio/broadcast_kind.hpp"
 #include "studio/message_handler.hpp"
 #include "studio/studio_session.hpp"
 
@@ -40,7 +43,8 @@ struct ServerOptions {
 
 /// What the server asks of the computation side (studio_compute.hpp implements it).
 struct ServerHooks {
-  /// Messages a newly connected client needs besides the state (the mesh, the latest result).
+  /// Messages a newly connected client needs besides the state: the latest result with its whole
+  /// surface (queued as BroadcastKind::full_result, so it replaces an older result still unsent).
   std::function<std::vector<std::string>()> welcome_messages;
   /// Called on the I/O thread after every acknowledged edit with the new design.
   std::function<void(const StudioSession&)> design_changed;
@@ -64,8 +68,9 @@ class StudioServer {
   void run();
   /// Thread safe: ends run().
   void stop();
-  /// Thread safe: sends `text` to every connected WebSocket client.
-  void broadcast(std::string text);
+  /// Thread safe: sends `text` to every connected WebSocket client; `kind` says which of a
+  /// client's unsent messages it replaces.
+  void broadcast(std::string text, BroadcastKind kind = BroadcastKind::every);
 
   struct Impl;  ///< the connections and the I/O loop (studio_server.cpp)
 

@@ -17,8 +17,9 @@ import { freshSessionDir, requireTools, startServer } from './harness.mjs';
 
 const SOAK_SECONDS = Number(process.env.CLEAVE_SOAK_SECONDS || 20);  // bounded soak; 60 s in docs/ROBUSTNESS.md
 const KILL_ROUNDS = Number(process.env.CLEAVE_KILL_ROUNDS || 6);
-// Resident memory may grow while caches warm up (first quarter of the soak); after that the
-// median of the last quarter must stay within this of the median of the second quarter.
+// Resident memory is sampled once the first edit's result is in (the caches it builds are the
+// bulk); it may still grow in the first quarter of the soak, after that the median of the last
+// quarter must stay within this of the median of the second quarter.
 const SOAK_RSS_GROWTH_MIB = 32;
 const SOAK_CLIENTS = 16;
 const tools = requireTools();
@@ -162,11 +163,13 @@ function openStalledClient(port) {
 }
 
 // A client that stops reading must not make the server hold every result since (2.5 MB each at
-// 45k cells): once its unsent messages pass the byte budget (--max-send-queue-mb) it is
-// disconnected; the client that reads gets every result and the server goes on.
+// 45k cells): it holds the one being written and the newest (a newer result replaces an unsent
+// one), and once its unsent messages pass the byte budget (--max-send-queue-mb; here 0.5 MB,
+// below two results of this size, above one) it is disconnected; the client that reads gets
+// every result and the server goes on.
 test('a client that stops reading is dropped at the send-queue byte budget; the others go on', { timeout: 180000 }, async () => {
   const slow = await startServer({ bin: tools.bin, session: freshSessionDir('slow'), res: '48x16x32',
-    extraArgs: ['--max-send-queue-mb', '1'] });
+    extraArgs: ['--max-send-queue-mb', '0.5'] });
   try {
     const stalled = await openStalledClient(slow.port);
     let stalledClosed = false;
@@ -199,6 +202,7 @@ test('a client that stops reading is dropped at the send-queue byte budget; the 
     while (!stalledClosed && Date.now() < deadline) await new Promise((r) => setTimeout(r, 100));
     assert.ok(stalledClosed, `the stalled client was not dropped after ${edits} edits of ${resultBytes} bytes each`);
     assert.ok(results >= edits, `the reading client got ${results} results for ${edits} edits`);
+    assert.ok(resultBytes > (1 << 19) / 2 && resultBytes < (1 << 19), `results of ${resultBytes} bytes: one fits the budget, two do not`);
     assert.equal((await request(ws, { cmd: 'ping' })).type, 'pong');
     ws.close();
   } finally {
@@ -206,8 +210,8 @@ test('a client that stops reading is dropped at the send-queue byte budget; the 
   }
 });
 
-// A client that reads slowly while another one edits in a burst: the broadcast states it has not
-// been sent yet are replaced by the newest (only the newest design matters), so 600 edits, more
+// A client that reads slowly while another one edits in a burst: the broadcast states and results
+// it has not been sent yet are replaced by the newest (only the newest design matters), so 600 edits, more
 // than the 512 queued messages that drop a client, leave it connected; once it reads, it gets far
 // fewer states than edits, the last one the newest. Results first fill what the kernel buffers
 // for it (a few MB on loopback), so that the server's own queue holds the states.
@@ -255,6 +259,9 @@ test('a slow reader gets the newest state instead of one per edit', { timeout: 1
     assert.ok(states < (filling + EDITS) / 4, `${states} states for ${filling + EDITS} edits`);
     assert.ok(burst < EDITS / 4, `${burst} states for the burst's ${EDITS} edits`);
     assert.ok(seqs.includes(last), `the newest state (seq ${last}) among ${seqs.slice(-5)}`);
+    // Results too: each is a snapshot, so a newer one takes the place of one still unsent.
+    const results = [...text.matchAll(/"type":"result"/g)].length;
+    assert.ok(results < (filling + EDITS) / 4, `${results} results for ${filling + EDITS} edits`);
     stalled.destroy();
   } finally {
     await server.stop();
@@ -270,6 +277,18 @@ test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknow
   let sampler = null;
   try {
     clients = await Promise.all(Array.from({ length: SOAK_CLIENTS }, () => openSocket(soak.url)));
+    // Warm-up: the first edit's result builds what every later one reuses (the incision preview's
+    // factor: about 200 MiB at this size), so memory is sampled from its arrival on.
+    let warmSeq = Infinity;  // the warm-up edit's seq once acknowledged (its result follows the ack)
+    const firstResult = new Promise((resolve) => {
+      clients[0].onpush = (m) => { if (m.type === 'result' && m.seq >= warmSeq) resolve(); };
+    });
+    const warmup = await request(clients[0], { cmd: 'add_control_point', position_mm: [-1, 0, 0], langer_kPa: 10, cross_kPa: 1 });
+    assert.equal(warmup.type, 'ack');
+    warmSeq = warmup.seq;
+    acked.push(warmup.seq);
+    await firstResult;
+    clients[0].onpush = null;
     const rss = [];
     sampler = setInterval(() => rss.push(rssMiB(soak.process.pid)), 500);
     const deadline = Date.now() + SOAK_SECONDS * 1000;
@@ -312,6 +331,9 @@ test(`soak: ${SOAK_CLIENTS} clients editing for ${SOAK_SECONDS} s lose no acknow
     console.log(`soak: ${acked.length} acknowledged edits by ${SOAK_CLIENTS} clients in ${SOAK_SECONDS} s, all restored after SIGKILL; ` +
       `RSS MiB first ${rss[0].toFixed(1)}, second-quarter median ${warm.toFixed(1)}, last-quarter median ${last.toFixed(1)}, ` +
       `max ${Math.max(...rss).toFixed(1)} (${rss.length} samples)`);
+  } catch (e) {
+    e.message += `\nthe server printed:\n${soak.output()}`;
+    throw e;
   } finally {
     // A failure above must not leave the sampler or the sockets keeping this file's process alive.
     clearInterval(sampler);

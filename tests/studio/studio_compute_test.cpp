@@ -10,7 +10,9 @@
 #include <filesystem>
 #include <functional>
 #include <fstream>
+#include <map>
 #include <mutex>
+#include <set>
 #include <thread>
 #include <unistd.h>
 
@@ -83,11 +85,16 @@ struct MessageLog {
   std::string only_type;  ///< empty: every message
   std::mutex mutex;
   std::vector<json> messages;
-  std::function<void(std::string)> sender() {
-    return [this](std::string text) {
+  std::vector<BroadcastKind> kinds;  ///< of each message kept
+  std::map<std::string, std::set<BroadcastKind>> kinds_of_type;  ///< of every message sent
+  StudioCompute::Send sender() {
+    return [this](std::string text, BroadcastKind kind) {
       json message = wire_decoded(text);
       std::lock_guard lock(mutex);
-      if (only_type.empty() || message["type"] == only_type) messages.push_back(std::move(message));
+      kinds_of_type[message["type"]].insert(kind);
+      if (!only_type.empty() && message["type"] != only_type) return;
+      messages.push_back(std::move(message));
+      kinds.push_back(kind);
     };
   }
 };
@@ -174,6 +181,10 @@ TEST(StudioCompute, AResultOnTheSameSurfaceLeavesItsTrianglesOutAndANewClientGet
   EXPECT_EQ(second["id"], first["id"]);
   ASSERT_TRUE(third.contains("triangles")) << "a cut makes a new surface";
   EXPECT_NE(third["id"], first["id"]);
+  // What each may replace in a slow client's queue (broadcast_kind.hpp): only a result that
+  // carries its triangles may stand in for one that carried them.
+  EXPECT_EQ(log.kinds, (std::vector<BroadcastKind>{BroadcastKind::full_result, BroadcastKind::partial_result,
+                                                   BroadcastKind::full_result, BroadcastKind::full_result}));
 
   // The packed arrays describe one mesh: every index names a vertex, every field has one value per vertex.
   const std::vector<float> positions = unpacked_floats(second["positions_mm"]);
@@ -263,6 +274,8 @@ TEST(StudioCompute, MeasurementsAfterACutEqualThoseOfASessionThatStartedWithIt) 
     compute.design_changed(session.design(), session.seq());
     compute.wait_idle();
     std::lock_guard lock(log.mutex);
+    // The wound opening's frames lead up to the result: a newer result never moves ahead of one.
+    EXPECT_EQ(log.kinds_of_type["frame"], std::set<BroadcastKind>{BroadcastKind::frame});
     return log.messages.back();
   };
   const json late = last_result("measure-late", false);
