@@ -112,7 +112,8 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   void read() {
     ws_.async_read(buffer_, [self = shared_from_this()](beast::error_code ec, std::size_t) {
       if (ec) {
-        if (ec != websocket::error::closed && ec != net::error::eof && ec != net::error::operation_aborted)
+        if (ec != websocket::error::closed && ec != net::error::eof && ec != net::error::operation_aborted &&
+            ec != net::error::connection_reset)
           fmt::print(stderr, "cleave studio: a client's connection ended: {}\n", ec.message());
         self->close();
         return;
