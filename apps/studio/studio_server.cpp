@@ -168,9 +168,10 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     // alone is never a backlog, whatever its size.
     if (queue_.size() >= kMaxQueuedMessages ||
         (!queue_.empty() && queued_bytes_ + text->size() > server_.options.max_queued_bytes)) {
-      fmt::print(stderr, "cleave studio: a client was disconnected: its send queue held {} messages, {:.1f} MiB (limits {}, {} MiB)\n",
-                 queue_.size(), static_cast<double>(queued_bytes_ + text->size()) / (1 << 20), kMaxQueuedMessages,
-                 server_.options.max_queued_bytes >> 20);
+      constexpr double kMiB = 1 << 20;
+      fmt::print(stderr, "cleave studio: a client was disconnected: its send queue held {} messages, {:.2f} MiB (limits {}, {:.2f} MiB)\n",
+                 queue_.size() + 1, static_cast<double>(queued_bytes_ + text->size()) / kMiB, kMaxQueuedMessages,
+                 static_cast<double>(server_.options.max_queued_bytes) / kMiB);
       close();
       return;
     }
