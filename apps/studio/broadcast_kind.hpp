@@ -10,7 +10,8 @@
 namespace cleave::studio {
 
 enum class BroadcastKind {
-  every,           ///< progress messages: every one is sent
+  every,           ///< progress messages, replies: every one is sent
+  state,           ///< the design after an edit: replaces the newest queued state
   frame,           ///< a frame of a wound opening: every one is sent, and a newer result queues after it
   full_result,     ///< a result with its whole surface: replaces the newest queued result
   partial_result,  ///< a result without the surface parts sent before: replaces the newest queued

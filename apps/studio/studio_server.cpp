@@ -61,9 +61,8 @@ struct StudioServer::Impl {
 
   Impl(StudioSession& s, ServerOptions o, ServerHooks h) : session(s), options(std::move(o)), hooks(std::move(h)) {}
   void accept();
+  /// To every client; `kind` says which unsent message it replaces (WsClient::send).
   void broadcast_now(const std::shared_ptr<const std::string>& text, BroadcastKind kind);
-  /// The state after an edit, to every client (WsClient::send_state).
-  void broadcast_state(const std::shared_ptr<const std::string>& text);
   nlohmann::json handle_text(const std::string& text, bool& design_changed);
 };
 
@@ -87,25 +86,13 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     });
   }
 
-  /// The kinds of queued message a newer one may replace while unsent.
-  enum class Kind { plain, frame, state, full_result, partial_result };
-
-  void send(std::shared_ptr<const std::string> text) { enqueue(std::move(text), Kind::plain); }
-
-  /// A broadcast "state" (the whole design after an edit): only the newest matters, so one still
-  /// waiting in the queue (not the one being written) is replaced by it in place. It stays ahead
-  /// of the sender's acknowledgement, which is queued after it; a client that reads slowly during
-  /// a burst of edits from other clients holds one state, not one per edit.
-  void send_state(std::shared_ptr<const std::string> text) { enqueue_replacing(std::move(text), Kind::state); }
-
-  /// A broadcast result or message of another kind (broadcast_kind.hpp).
-  void send_broadcast(std::shared_ptr<const std::string> text, BroadcastKind kind) {
-    switch (kind) {
-      case BroadcastKind::every: return send(std::move(text));
-      case BroadcastKind::frame: return enqueue(std::move(text), Kind::frame);
-      case BroadcastKind::full_result: return enqueue_replacing(std::move(text), Kind::full_result);
-      case BroadcastKind::partial_result: return enqueue_replacing(std::move(text), Kind::partial_result);
-    }
+  /// Queues `text`, or puts it in place of an unsent message it replaces (broadcast_kind.hpp).
+  /// A broadcast state (the whole design after an edit) stays ahead of the sender's
+  /// acknowledgement, which is queued after it; a client that reads slowly during a burst of
+  /// edits from other clients holds one state, not one per edit.
+  void send(std::shared_ptr<const std::string> text, BroadcastKind kind = BroadcastKind::every) {
+    if (kind == BroadcastKind::every || kind == BroadcastKind::frame) enqueue(std::move(text), kind);
+    else enqueue_replacing(std::move(text), kind);
   }
 
  private:
@@ -130,30 +117,31 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
         // The new state reaches every client before the sender's acknowledgement, so a client
         // that acts on the ack already holds the state it acknowledges.
         if (design_changed)
-          self->server_.broadcast_state(std::make_shared<const std::string>(self->server_.session.state_message().dump()));
+          self->server_.broadcast_now(std::make_shared<const std::string>(self->server_.session.state_message().dump()),
+                                      BroadcastKind::state);
         self->send(std::make_shared<const std::string>(reply.dump()));
         if (is_hello && self->server_.hooks.welcome_messages)
           for (std::string& m : self->server_.hooks.welcome_messages())
-            self->enqueue_replacing(std::make_shared<const std::string>(std::move(m)), Kind::full_result);
+            self->send(std::make_shared<const std::string>(std::move(m)), BroadcastKind::full_result);
         if (design_changed && self->server_.hooks.design_changed) self->server_.hooks.design_changed(self->server_.session);
       }
       self->read();
     });
   }
 
-  static bool is_result(Kind kind) { return kind == Kind::full_result || kind == Kind::partial_result; }
+  static bool is_result(BroadcastKind kind) { return kind == BroadcastKind::full_result || kind == BroadcastKind::partial_result; }
 
   /// Replaces the newest unsent message of `kind`'s family in place (a state any state; a full
   /// result any result queued after the last frame; a partial result only a partial one), else
   /// queues `text`.
-  void enqueue_replacing(std::shared_ptr<const std::string> text, Kind kind) {
+  void enqueue_replacing(std::shared_ptr<const std::string> text, BroadcastKind kind) {
     if (closed_) return;
     for (std::size_t i = queue_.size(); i-- > 1;) {  // queue_[0] is being written
       Queued& queued = queue_[i];
-      if (is_result(kind) && queued.kind == Kind::frame) break;
-      const bool same_family = kind == Kind::state ? queued.kind == Kind::state : is_result(queued.kind);
+      if (is_result(kind) && queued.kind == BroadcastKind::frame) break;
+      const bool same_family = kind == BroadcastKind::state ? queued.kind == BroadcastKind::state : is_result(queued.kind);
       if (!same_family) continue;
-      if (kind == Kind::partial_result && queued.kind != Kind::partial_result) break;
+      if (kind == BroadcastKind::partial_result && queued.kind != BroadcastKind::partial_result) break;
       queued_bytes_ = queued_bytes_ - queued.text->size() + text->size();
       queued.text = std::move(text);
       queued.kind = kind;
@@ -162,7 +150,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
     enqueue(std::move(text), kind);
   }
 
-  void enqueue(std::shared_ptr<const std::string> text, Kind kind) {
+  void enqueue(std::shared_ptr<const std::string> text, BroadcastKind kind) {
     if (closed_) return;
     // A client that does not read: drop it before its queue holds everything since. One message
     // alone is never a backlog, whatever its size.
@@ -211,7 +199,7 @@ class WsClient : public std::enable_shared_from_this<WsClient> {
   beast::flat_buffer buffer_;
   struct Queued {
     std::shared_ptr<const std::string> text;
-    Kind kind = Kind::plain;  ///< what a newer message may replace it by while unsent
+    BroadcastKind kind = BroadcastKind::every;  ///< what a newer message may replace it by while unsent
   };
   std::deque<Queued> queue_;
   std::size_t queued_bytes_ = 0;  ///< of the messages in queue_ (the one being written included)
@@ -336,12 +324,7 @@ void StudioServer::Impl::accept() {
 
 void StudioServer::Impl::broadcast_now(const std::shared_ptr<const std::string>& text, BroadcastKind kind) {
   const auto copy = clients;  // sending may drop a client from the set
-  for (const auto& c : copy) c->send_broadcast(text, kind);
-}
-
-void StudioServer::Impl::broadcast_state(const std::shared_ptr<const std::string>& text) {
-  const auto copy = clients;  // send_state() may drop a client from the set
-  for (const auto& c : copy) c->send_state(text);
+  for (const auto& c : copy) c->send(text, kind);
 }
 
 nlohmann::json StudioServer::Impl::handle_text(const std::string& text, bool& design_changed) {
