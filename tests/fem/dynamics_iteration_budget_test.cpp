@@ -33,15 +33,17 @@ DynamicsSettings opening_settings(const LinkedVolume& volume, int iterations_per
 TEST(DynamicsIterationBudget, BudgetedStepsFollowTheSolvedOpeningAndRestAtItsEquilibrium) {
   const OpeningPlate plate;
   Dynamics solved(plate.model, plate.stress, opening_settings(plate.model.volume, 0));
-  // 4 per step, as the studio's opening: 2 left the opening 14 % of the motion off, 3 5 %, 6 0.2 %.
-  Dynamics budgeted(plate.model, plate.stress, opening_settings(plate.model.volume, 4));
+  // kRealTimeIterationsPerStep (5) per step with one damped block-Jacobi step on each side of the
+  // fine level's coarse correction, as the studio's opening: 1.2 % of the motion off (the cycle
+  // of every solve, Chebyshev degree 2, took it to 0.8 % with 4 iterations, 0.7 % with 5).
+  Dynamics budgeted(plate.model, plate.stress, opening_settings(plate.model.volume, kRealTimeIterationsPerStep));
   double diff = 0, motion = 0;
   int solved_iterations = 0, budgeted_iterations = 0;
   for (int i = 0; i < 120; ++i) {
     const SolveReport s = solved.step(kDisplayStep_s);
     const SolveReport b = budgeted.step(kDisplayStep_s);
     ASSERT_TRUE(s.converged);
-    ASSERT_LE(b.iterations, 4);
+    ASSERT_LE(b.iterations, kRealTimeIterationsPerStep);
     solved_iterations += s.iterations;
     budgeted_iterations += b.iterations;
     if (i < 30) {  // the opening: the first half second

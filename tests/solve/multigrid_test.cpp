@@ -7,6 +7,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 #include <map>
 #include <string>
 
@@ -327,6 +328,46 @@ TEST(Multigrid, CoarseLevelsSmoothWithTheirOwnDegree) {
   } catch (const InputError& e) {
     EXPECT_STREQ(e.what(), "multigrid: coarse smoother degree is 0; expected 1 or more");
   }
+}
+
+// The fine level's Chebyshev interval and degree can differ from the coarse levels' (the
+// real-time step's fine level: degree 1 over [lambda_max / 4, lambda_max]); bad ones are refused.
+TEST(Multigrid, TheFineLevelSmoothsOverItsOwnInterval) {
+  const TissueModel model = test::make_box({48, 24, 12}, 10.0 / 12);
+  const test::LinearSystem s = test::clamped_system(model, test::Clamp::left_end);
+  MultigridOptions options;
+  options.coarsest_max_dofs = 100;
+  options.smoother.degree = 1;
+  options.smoother.smoothing_range = 4.0;
+  const MultigridPreconditioner m = build_multigrid(s.a, model.volume, options);
+  ASSERT_GE(m.levels().size(), 3u);
+  EXPECT_EQ(m.levels()[0].smoother.options.degree, 1);
+  EXPECT_EQ(m.levels()[0].smoother.options.smoothing_range, 4.0);
+  for (std::size_t l = 1; l + 1 < m.levels().size(); ++l) {
+    EXPECT_EQ(m.levels()[l].smoother.options.degree, options.coarse_degree);
+    EXPECT_EQ(m.levels()[l].smoother.options.smoothing_range, options.coarse_smoothing_range);
+  }
+  // Still a preconditioner that converges: CG with it solves the clamped block.
+  EXPECT_LT(multigrid_iterations(model, test::Clamp::left_end, options), 60);
+  const auto refusal = [&](const MultigridOptions& bad) {
+    try {
+      (void)build_multigrid(s.a, model.volume, bad);
+      return std::string("no error");
+    } catch (const InputError& e) {
+      return std::string(e.what());
+    }
+  };
+  MultigridOptions bad = options;
+  bad.smoother.degree = 0;
+  EXPECT_EQ(refusal(bad), "multigrid: fine smoother degree is 0; expected 1 or more");
+  bad = options;
+  bad.smoother.smoothing_range = 1.0;
+  EXPECT_EQ(refusal(bad), "multigrid: smoothing range is 1; expected a finite ratio above 1 (lambda_max over the lower end of "
+                          "the damped interval)");
+  bad = options;
+  bad.coarse_smoothing_range = std::numeric_limits<double>::quiet_NaN();
+  EXPECT_EQ(refusal(bad), "multigrid: smoothing range is nan; expected a finite ratio above 1 (lambda_max over the lower end of "
+                          "the damped interval)");
 }
 
 // A solve with kept (stale) coarse levels that needs far more iterations than the first solve

@@ -205,11 +205,20 @@ MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const V
   m.precision_ = options.precision;
   if (options.coarse_degree < 1)
     throw InputError(fmt::format("multigrid: coarse smoother degree is {}; expected 1 or more", options.coarse_degree));
+  if (options.smoother.degree < 1)
+    throw InputError(fmt::format("multigrid: fine smoother degree is {}; expected 1 or more", options.smoother.degree));
+  for (const double range : {options.smoother.smoothing_range, options.coarse_smoothing_range})
+    if (!(range > 1 && std::isfinite(range)))
+      throw InputError(fmt::format("multigrid: smoothing range is {}; expected a finite ratio above 1 (lambda_max over the lower "
+                                   "end of the damped interval)", range));
   const bool apply_fine_operator = fine_operator != nullptr && m.levels_.size() > 1;
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     MultigridLevel& level = m.levels_[l];
     ChebyshevOptions smoother = options.smoother;
-    if (l > 0) smoother.degree = options.coarse_degree;
+    if (l > 0) {
+      smoother.degree = options.coarse_degree;
+      smoother.smoothing_range = options.coarse_smoothing_range;
+    }
     if (l == 0 && apply_fine_operator) {
       m.fine_operator_ = fine_operator;
       level.smoother =

@@ -58,6 +58,10 @@ struct MultigridOptions {
   /// saves on the bench's step (equal times), 0.94x in the step harness; the preview needs fewer
   /// iterations (62 -> 51 on the 350k-cell tube).
   int coarse_degree = 3;
+  /// The coarse levels' smoothing range (lambda_max over the lower end of the interval they damp;
+  /// the fine level's is smoother.smoothing_range), so that the fine level's can differ: the
+  /// real-time step smooths its fine level with one damped block-Jacobi step (degree 1, range 4).
+  double coarse_smoothing_range = 8.0;
   /// The cycle's precision at build; multigrid_cg_solver falls back to double when float rounding
   /// stalls CG with the single-precision cycle.
   CyclePrecision precision = CyclePrecision::single_precision;
