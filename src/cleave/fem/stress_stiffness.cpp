@@ -4,7 +4,12 @@
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
+#include <array>
+#include <optional>
+
+#include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/corotation.hpp"
+#include "cleave/fem/tensile_part_avx512.hpp"
 
 namespace cleave {
 namespace {
@@ -15,13 +20,49 @@ bool positive_semidefinite(const Vec6& s) {
          s[1] * s[2] >= s[5] * s[5] && from_voigt(s).determinant() >= 0;
 }
 
+/// The tensile part where the stress is semi-definite (most cells of tissue under tension are
+/// wholly tensile, the rest often wholly compressive); none where it is mixed in sign.
+std::optional<Vec6> definite_tensile_part(const Vec6& stress_kPa) {
+  if (positive_semidefinite(stress_kPa)) return stress_kPa;
+  if (positive_semidefinite(-stress_kPa)) return Vec6::Zero();
+  return std::nullopt;
+}
+
+/// The mixed cells of one range, their tensile parts taken 8 at a time in AVX-512 lanes where the
+/// CPU has them (fem/tensile_part_avx512.hpp), one by one with Eigen's closed form elsewhere.
+class MixedCells {
+ public:
+  explicit MixedCells(std::vector<Vec6>& tension_kPa) : tension_kPa_(tension_kPa) {}
+  void add(CellId c, const Vec6& stress_kPa) {
+    stress_[static_cast<std::size_t>(count_)] = stress_kPa;
+    cell_[static_cast<std::size_t>(count_)] = c;
+    if (++count_ == kLanes) flush();
+  }
+  void flush() {
+    if (count_ == 0) return;
+    if (avx512_cell_pass_supported()) {
+      std::array<Vec6, kLanes> out;
+      tensile_parts_avx512(stress_[0].data(), out[0].data(), count_, JacobiSweeps{});
+      for (int i = 0; i < count_; ++i) tension_kPa_[static_cast<std::size_t>(cell_[static_cast<std::size_t>(i)])] = out[static_cast<std::size_t>(i)];
+    } else {
+      for (int i = 0; i < count_; ++i)
+        tension_kPa_[static_cast<std::size_t>(cell_[static_cast<std::size_t>(i)])] = tensile_part(stress_[static_cast<std::size_t>(i)]);
+    }
+    count_ = 0;
+  }
+
+ private:
+  static constexpr int kLanes = 8;
+  std::vector<Vec6>& tension_kPa_;
+  std::array<Vec6, kLanes> stress_;
+  std::array<CellId, kLanes> cell_{};
+  int count_ = 0;
+};
+
 }  // namespace
 
 Vec6 tensile_part(const Vec6& stress_kPa) {
-  // Most cells of tissue under tension are wholly tensile, the rest often wholly compressive:
-  // the eigen decomposition only for the mixed ones.
-  if (positive_semidefinite(stress_kPa)) return stress_kPa;
-  if (positive_semidefinite(-stress_kPa)) return Vec6::Zero();
+  if (const std::optional<Vec6> definite = definite_tensile_part(stress_kPa)) return *definite;
   Eigen::SelfAdjointEigenSolver<Mat3> eigen;
   eigen.computeDirect(from_voigt(stress_kPa));
   const Mat3& axes = eigen.eigenvectors();
@@ -34,12 +75,15 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
   rotations.resize(cells);
   tension_kPa.resize(cells);
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
+    MixedCells mixed(tension_kPa);
     cell_frames_in_range(volume, displacement_mm, r.begin(), r.end(), rotations, [&](CellId c, const Mat3& f) {
       const auto ci = static_cast<std::size_t>(c);
       Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, rotations[ci]);
       if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
-      tension_kPa[ci] = tensile_part(stress);
+      if (const std::optional<Vec6> definite = definite_tensile_part(stress)) tension_kPa[ci] = *definite;
+      else mixed.add(c, stress);
     });
+    mixed.flush();
   });
 }
 
