@@ -43,8 +43,8 @@ constexpr int kOpeningFrames = 8;
 constexpr double kOpeningStep_s = 0.03;            ///< 8 steps: the first 0.24 s of the opening (Newmark is stable at any step)
 constexpr double kOpeningDamping_per_s = 20.0;     ///< mass damping, as examples/plate_flap_dynamic.json
 /// The opening's frames solve with a budget (DynamicsSettings::iterations_per_step): 5 multigrid CG
-/// iterations with a light fine smoother instead of the 8-15 a step needs to its tolerance; the picture after the frames
-/// is the statics' equilibrium, solved exactly.
+/// iterations of a cycle with a light fine smoother instead of the 8-15 a step needs to its
+/// tolerance; the picture after the frames is the statics' equilibrium, solved exactly.
 constexpr int kOpeningIterationsPerStep = kRealTimeIterationsPerStep;
 /// Generalized-alpha with nothing left of what 30 ms steps cannot resolve: the opening's own
 /// modes (in-plane waves cross a cut in about 3 ms). Under HHT (radius 0.67) the streamed width

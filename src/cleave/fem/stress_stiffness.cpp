@@ -34,29 +34,28 @@ class MixedCells {
  public:
   explicit MixedCells(std::vector<Vec6>& tension_kPa) : tension_kPa_(tension_kPa) {}
   void add(CellId c, const Vec6& stress_kPa) {
-    stress_[static_cast<std::size_t>(count_)] = stress_kPa;
-    cell_[static_cast<std::size_t>(count_)] = c;
+    stress_[count_] = stress_kPa;
+    cell_[count_] = static_cast<std::size_t>(c);
     if (++count_ == kLanes) flush();
   }
   void flush() {
     if (count_ == 0) return;
     if (avx512_cell_pass_supported()) {
       std::array<Vec6, kLanes> out;
-      tensile_parts_avx512(stress_[0].data(), out[0].data(), count_, JacobiSweeps{});
-      for (int i = 0; i < count_; ++i) tension_kPa_[static_cast<std::size_t>(cell_[static_cast<std::size_t>(i)])] = out[static_cast<std::size_t>(i)];
+      tensile_parts_avx512(stress_[0].data(), out[0].data(), static_cast<int>(count_), JacobiSweeps{});
+      for (std::size_t i = 0; i < count_; ++i) tension_kPa_[cell_[i]] = out[i];
     } else {
-      for (int i = 0; i < count_; ++i)
-        tension_kPa_[static_cast<std::size_t>(cell_[static_cast<std::size_t>(i)])] = tensile_part(stress_[static_cast<std::size_t>(i)]);
+      for (std::size_t i = 0; i < count_; ++i) tension_kPa_[cell_[i]] = tensile_part(stress_[i]);
     }
     count_ = 0;
   }
 
  private:
-  static constexpr int kLanes = 8;
+  static constexpr std::size_t kLanes = 8;
   std::vector<Vec6>& tension_kPa_;
   std::array<Vec6, kLanes> stress_;
-  std::array<CellId, kLanes> cell_{};
-  int count_ = 0;
+  std::array<std::size_t, kLanes> cell_{};
+  std::size_t count_ = 0;
 };
 
 }  // namespace
