@@ -28,6 +28,14 @@ std::optional<Vec6> definite_tensile_part(const Vec6& stress_kPa) {
   return std::nullopt;
 }
 
+/// The tensile part of a stress mixed in sign, by Eigen's closed-form decomposition.
+Vec6 mixed_tensile_part(const Vec6& stress_kPa) {
+  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
+  eigen.computeDirect(from_voigt(stress_kPa));
+  const Mat3& axes = eigen.eigenvectors();
+  return to_voigt(axes * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * axes.transpose());
+}
+
 /// The mixed cells of one range, their tensile parts taken 8 at a time in AVX-512 lanes where the
 /// CPU has them (fem/tensile_part_avx512.hpp), one by one with Eigen's closed form elsewhere.
 class MixedCells {
@@ -45,7 +53,7 @@ class MixedCells {
       tensile_parts_avx512(stress_[0].data(), out[0].data(), static_cast<int>(count_), JacobiSweeps{});
       for (std::size_t i = 0; i < count_; ++i) tension_kPa_[cell_[i]] = out[i];
     } else {
-      for (std::size_t i = 0; i < count_; ++i) tension_kPa_[cell_[i]] = tensile_part(stress_[i]);
+      for (std::size_t i = 0; i < count_; ++i) tension_kPa_[cell_[i]] = mixed_tensile_part(stress_[i]);
     }
     count_ = 0;
   }
@@ -62,10 +70,7 @@ class MixedCells {
 
 Vec6 tensile_part(const Vec6& stress_kPa) {
   if (const std::optional<Vec6> definite = definite_tensile_part(stress_kPa)) return *definite;
-  Eigen::SelfAdjointEigenSolver<Mat3> eigen;
-  eigen.computeDirect(from_voigt(stress_kPa));
-  const Mat3& axes = eigen.eigenvectors();
-  return to_voigt(axes * eigen.eigenvalues().cwiseMax(0.0).asDiagonal() * axes.transpose());
+  return mixed_tensile_part(stress_kPa);
 }
 
 void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,

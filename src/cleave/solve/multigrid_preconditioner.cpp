@@ -159,6 +159,14 @@ MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const V
   if (!(options.coarsest_factor_flops_per_fine_entry >= 0 && std::isfinite(options.coarsest_factor_flops_per_fine_entry)))
     throw InputError(fmt::format("multigrid: coarsest factor flops per fine entry is {}; expected a finite number of 0 or more",
                                  options.coarsest_factor_flops_per_fine_entry));
+  if (options.coarse_degree < 1)
+    throw InputError(fmt::format("multigrid: coarse smoother degree is {}; expected 1 or more", options.coarse_degree));
+  if (options.smoother.degree < 1)
+    throw InputError(fmt::format("multigrid: fine smoother degree is {}; expected 1 or more", options.smoother.degree));
+  for (const double range : {options.smoother.smoothing_range, options.coarse_smoothing_range})
+    if (!(range > 1 && std::isfinite(range)))
+      throw InputError(fmt::format("multigrid: smoothing range is {}; expected a finite ratio above 1 (lambda_max over the lower "
+                                   "end of the damped interval)", range));
   MultigridPreconditioner m;
   m.levels_.reserve(static_cast<std::size_t>(std::max(options.max_levels, 1)));  // no reallocation: it would copy the levels' matrices
   GridLevel grid = grid_level_of(volume);
@@ -203,14 +211,6 @@ MultigridPreconditioner build_levels(const BlockSparseMatrix<double>& a, const V
     coarse.fixed = identity_rows(coarse.matrix);
   }
   m.precision_ = options.precision;
-  if (options.coarse_degree < 1)
-    throw InputError(fmt::format("multigrid: coarse smoother degree is {}; expected 1 or more", options.coarse_degree));
-  if (options.smoother.degree < 1)
-    throw InputError(fmt::format("multigrid: fine smoother degree is {}; expected 1 or more", options.smoother.degree));
-  for (const double range : {options.smoother.smoothing_range, options.coarse_smoothing_range})
-    if (!(range > 1 && std::isfinite(range)))
-      throw InputError(fmt::format("multigrid: smoothing range is {}; expected a finite ratio above 1 (lambda_max over the lower "
-                                   "end of the damped interval)", range));
   const bool apply_fine_operator = fine_operator != nullptr && m.levels_.size() > 1;
   for (std::size_t l = 0; l + 1 < m.levels_.size(); ++l) {
     MultigridLevel& level = m.levels_[l];
