@@ -132,6 +132,51 @@ TEST(CorotatedSystemOperator, ProductEqualsTheAssembledSystemOnACutBodyUnderTens
   EXPECT_LE((y - a * x2).lpNorm<Eigen::Infinity>(), 1e-12 * 2.0 * scale);
 }
 
+// Cells held at all 8 corners (the studio's removed plugs and supports) feed identity rows only:
+// the products leave them out and stay those of the assembled matrix, also when the held dofs
+// change between states (the cells left out before are computed again, none is summed stale).
+TEST(CorotatedSystemOperator, CellsHeldAtEveryCornerAreLeftOutOfTheProducts) {
+  Fixture f;
+  const LinkedVolume& volume = f.model.volume;
+  const std::vector<std::uint8_t> scattered = f.fixed;
+  std::vector<std::uint8_t> slab = scattered;  // every vertex with x >= 4 cells held at all axes
+  for (VertexId v = 0; v < volume.vertex_count(); ++v)
+    if (volume.vertex_position_mm(v).x() >= volume.grid().origin_mm.x() + 4 * volume.grid().cell_size_mm - 1e-9)
+      for (int i = 0; i < 3; ++i) slab[static_cast<std::size_t>(3 * v + i)] = 1;
+  std::size_t free_cells = 0;
+  for (CellId c = 0; c < volume.cell_count(); ++c) {
+    const auto& corners = volume.cell_vertices(c);
+    free_cells += std::any_of(corners.begin(), corners.end(), [&](VertexId v) {
+      const auto i = static_cast<std::size_t>(3 * v);
+      return slab[i] == 0 || slab[i + 1] == 0 || slab[i + 2] == 0;
+    }) ? 1 : 0;
+  }
+  ASSERT_LT(free_cells, static_cast<std::size_t>(volume.cell_count()));
+  ASSERT_GT(free_cells, 0u);
+  CorotatedSystemOperator op;
+  op.set_topology(volume, f.table);
+  const std::vector<std::uint8_t>* sequence[] = {&scattered, &slab, &scattered, &slab};
+  for (const std::vector<std::uint8_t>* held : sequence) {
+    f.fixed = *held;
+    op.set_state(f.rotations, f.tension, kStiff, kStress, kMass, f.mass, f.fixed);
+    EXPECT_EQ(op.computed_cells(), held == &slab ? free_cells : static_cast<std::size_t>(volume.cell_count()));
+    const SparseMatrix a = f.assembled();
+    const Vector x = probe(a.rows());
+    const Vector expected = a * x;
+    const double scale = expected.lpNorm<Eigen::Infinity>();
+    Vector y;
+    op.multiply(x, y);
+    EXPECT_LE((y - expected).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+    Eigen::VectorXf y_single;
+    op.multiply(Eigen::VectorXf(x.cast<float>()), y_single);
+    EXPECT_LE((y_single.cast<double>() - expected).lpNorm<Eigen::Infinity>(), 3e-6 * scale);
+    const Vector b = probe(a.rows()).reverse();
+    Vector r;
+    op.residual(b, x, r);
+    EXPECT_LE((r - (b - expected)).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+  }
+}
+
 TEST(CorotatedSystemOperator, BlockDiagonalAndAssemblyEqualTheAssembledSystem) {
   const Fixture f;
   const SparseMatrix a = f.assembled();

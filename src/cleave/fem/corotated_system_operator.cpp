@@ -56,6 +56,7 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   material_ = material_slot_per_cell(table, volume);
   corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
+  cell_ranges_.clear();  // listed again by set_state for the new cells and vertices
   // The element matrices in corner modes, for the AVX-512 passes (none: the portable pass).
   stiffness_modes_.clear();
   stress_modes_.reset();
@@ -112,11 +113,12 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   rotations_ = rotations;
   with_tension_ = !tension_kPa.empty();
   fixed_ = &fixed;
-  if (fixed != fixed_seen_) {  // a step keeps its fixed dofs: listed once
+  if (fixed != fixed_seen_ || cell_ranges_.empty()) {  // a step keeps its fixed dofs: listed once
     fixed_seen_ = fixed;
     fixed_rows_.clear();
     for (std::size_t i = 0; i < dofs; ++i)
       if (fixed[i] != 0) fixed_rows_.push_back(static_cast<Eigen::Index>(i));
+    list_held_cells();
   }
   c_mass_ = c_mass;
   mass_kg_ = &mass_kg;
@@ -164,6 +166,42 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   single_.mass_term = twin_.mass_term.cast<float>();
 }
 
+void CorotatedSystemOperator::list_held_cells() {
+  const auto vertices = static_cast<std::size_t>(rows() / 3);
+  vertex_held_.assign(vertices, 0);
+  for (std::size_t v = 0; v < vertices; ++v)
+    vertex_held_[v] = fixed_seen_[3 * v] != 0 && fixed_seen_[3 * v + 1] != 0 && fixed_seen_[3 * v + 2] != 0 ? 1 : 0;
+  cell_ranges_.clear();
+  const std::size_t cells = material_.size();
+  const auto computed = [&](std::size_t c) {
+    const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
+    return std::any_of(corners.begin(), corners.end(), [&](VertexId v) { return vertex_held_[static_cast<std::size_t>(v)] == 0; });
+  };
+  for (std::size_t c = 0; c < cells;) {
+    if (!computed(c)) {
+      ++c;
+      continue;
+    }
+    const std::size_t begin = c;
+    while (c < cells && c - begin < static_cast<std::size_t>(kCellsPerTask) && computed(c)) ++c;
+    cell_ranges_.emplace_back(begin, c);
+  }
+  if (cell_ranges_.empty()) cell_ranges_.emplace_back(0, 0);  // listed (set_state lists only when empty or changed)
+}
+
+std::size_t CorotatedSystemOperator::computed_cells() const {
+  std::size_t count = 0;
+  for (const auto& [begin, end] : cell_ranges_) count += end - begin;
+  return count;
+}
+
+template <typename F>
+void CorotatedSystemOperator::for_each_cell_range(const F& f) const {
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges_.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k < r.end(); ++k) f(cell_ranges_[k].first, cell_ranges_[k].second);
+  });
+}
+
 template <>
 const Eigen::Matrix<float, 3, 3>& CorotatedSystemOperator::rotation_of<float>(const Precision<float>& p, std::size_t cell) const {
   return p.rotation[cell];
@@ -204,8 +242,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       in.stress_modes = p.stress_modes.data();
       in.tension = with_tension_ ? p.tension.front().data() : nullptr;
       in.per_cell = p.per_cell.data();
-      tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
-                        [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
+      for_each_cell_range([&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
       sum_per_vertex(p, x_in, *x, finish);
       return;
     }
@@ -220,14 +257,13 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
     in.stress_modes = p.stress_modes.data();
     in.tension = with_tension_ ? p.tension.front().data() : nullptr;
     in.per_cell = p.per_cell.data();
-    tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
-                      [&](const tbb::blocked_range<std::size_t>& r) { corotated_cells_avx512(in, r.begin(), r.end()); });
+    for_each_cell_range([&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
     sum_per_vertex(p, x_in, *x, finish);
     return;
   }
   if constexpr (std::is_same_v<Scalar, float>) form_stress_stiffness();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t c = r.begin(); c < r.end(); ++c) {
+  for_each_cell_range([&](std::size_t first, std::size_t last) {
+    for (std::size_t c = first; c < last; ++c) {
       const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
       const Mat3S& rotation = rotation_of(p, c);
       // The corners' x, y, z (world), then turned into the cell's frame: d_i = sum_j R_ji x_j.
@@ -276,6 +312,10 @@ void CorotatedSystemOperator::sum_per_vertex(const Precision<Scalar>& p, const E
   tbb::parallel_for(tbb::blocked_range<VertexId>(0, vertices, kVerticesPerTask), [&](const tbb::blocked_range<VertexId>& r) {
     for (VertexId v = r.begin(); v < r.end(); ++v) {
       const auto i = 3 * static_cast<Eigen::Index>(v);
+      if (vertex_held_[static_cast<std::size_t>(v)] != 0) {  // identity rows: no cell sum
+        finish(v, Eigen::Matrix<Scalar, 3, 1>(x_in.template segment<3>(i)));
+        continue;
+      }
       Eigen::Matrix<Scalar, 3, 1> sum = p.mass_term.template segment<3>(i).cwiseProduct(x_masked.template segment<3>(i));
       for (std::int32_t s = corner_slots_.start[static_cast<std::size_t>(v)]; s < corner_slots_.start[static_cast<std::size_t>(v) + 1]; ++s) {
         const Scalar* slot = p.per_cell.data() + corner_slots_.slot[static_cast<std::size_t>(s)];
