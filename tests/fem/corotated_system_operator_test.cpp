@@ -134,7 +134,8 @@ TEST(CorotatedSystemOperator, ProductEqualsTheAssembledSystemOnACutBodyUnderTens
 
 // Cells held at all 8 corners (the studio's removed plugs and supports) feed identity rows only:
 // the products leave them out and stay those of the assembled matrix, also when the held dofs
-// change between states (the cells left out before are computed again, none is summed stale).
+// change between states (the cells left out before are computed again, none is summed stale);
+// the block diagonal of a held vertex is the identity without its sum.
 TEST(CorotatedSystemOperator, CellsHeldAtEveryCornerAreLeftOutOfTheProducts) {
   Fixture f;
   const LinkedVolume& volume = f.model.volume;
@@ -174,6 +175,12 @@ TEST(CorotatedSystemOperator, CellsHeldAtEveryCornerAreLeftOutOfTheProducts) {
     Vector r;
     op.residual(b, x, r);
     EXPECT_LE((r - (b - expected)).lpNorm<Eigen::Infinity>(), 1e-12 * scale);
+    // The block diagonal's inverses: the identity on held vertices, as the assembled matrix's.
+    const std::vector<Mat3> inverse = op.inverse_diagonal_blocks();
+    const BlockJacobi jacobi = block_jacobi(a);
+    ASSERT_EQ(inverse.size(), jacobi.inverse_blocks.size());
+    for (std::size_t v = 0; v < inverse.size(); ++v)
+      ASSERT_LE((inverse[v] - jacobi.inverse_blocks[v]).norm(), 1e-12 * jacobi.inverse_blocks[v].norm()) << "vertex " << v;
   }
 }
 

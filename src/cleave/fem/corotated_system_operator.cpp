@@ -57,6 +57,7 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
   cell_ranges_.clear();  // listed again by set_state for the new cells and vertices
+  vertex_held_.clear();
   // The element matrices in corner modes, for the AVX-512 passes (none: the portable pass).
   stiffness_modes_.clear();
   stress_modes_.reset();
@@ -454,6 +455,10 @@ std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, static_cast<std::size_t>(kVerticesPerTask)),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t v = r.begin(); v < r.end(); ++v) {
+                        if (!vertex_held_.empty() && vertex_held_[v] != 0) {  // identity rows
+                          out[v] = Mat3::Identity();
+                          continue;
+                        }
                         Mat3 block = Mat3::Zero();
                         double stress_sum = 0;     // the stress stiffness's part: a multiple of I_3
                         double isotropic_sum = 0;  // the split blocks' isotropic part (R I R^T = I)
