@@ -81,10 +81,12 @@ struct DynamicsSettings {
   /// instead of degree 2: 3 fine products an iteration instead of 5, and 5 iterations instead of
   /// 4 in less time. Against steps solved to 1e-5, after 24 steps with a cut growing over the
   /// first 14, the largest vertex error (median over the steps, of the largest displacement) was
-  /// 1.2e-2 for both on the 44k tube, 9.2e-3 against 2.1e-2 on the 45k abdomen.
+  /// 1.2e-2 for both on the 44k tube, 9.2e-3 against 2.1e-2 on the 45k abdomen. After a cut its
+  /// fine smoother's bound continues with 2 power iterations instead of 4 (never lowered).
   /// A budgeted multigrid still rebuilds stale levels: it extrapolates the iterations a step
-  /// would have needed from the rate it reached (iterations_at_reached_rate). A non-finite
-  /// residual or a diverged motion still throws.
+  /// would have needed from the rate it reached (iterations_at_reached_rate); during a growing cut
+  /// that is every 3-5 steps, each such step 3-4 times as long (the harness
+  /// DISABLED_BudgetAccuracy prints them). A non-finite residual or a diverged motion still throws.
   int iterations_per_step = 0;
   double mass_damping_per_s = 0;        ///< Rayleigh alpha (1/s)
   double stiffness_damping_s = 0;       ///< Rayleigh beta (s)
