@@ -327,6 +327,12 @@ TEST(CorotatedSystemOperator, RefusesStateThatDoesNotFitItsTopology) {
     EXPECT_STREQ(e.what(), "corotated system: set_topology must come before set_state");
   }
   op.set_topology(f.model.volume, f.table);
+  try {
+    (void)op.inverse_diagonal_blocks();
+    FAIL() << "expected InputError";
+  } catch (const InputError& e) {
+    EXPECT_STREQ(e.what(), "corotated system: set_state must come before its block diagonal");
+  }
   const std::vector<Mat3> short_rotations(f.rotations.begin(), f.rotations.end() - 1);
   try {
     op.set_state(short_rotations, f.tension, 1, 1, 1, f.mass, f.fixed);

@@ -47,6 +47,38 @@ using Clock = std::chrono::steady_clock;
 using test::median_ms;
 using test::tube_44k;
 
+/// The 44k tube, or the abdomen at 126x41x84 with CLEAVE_BENCH_SHAPE=abdomen.
+bool abdomen_requested() {
+  const char* shape = std::getenv("CLEAVE_BENCH_SHAPE");
+  return shape != nullptr && std::string(shape) == "abdomen";
+}
+TissueModel benchmark_model() {
+  return abdomen_requested() ? make_tissue_model("abdomen", make_builtin_shape("abdomen", {Vec3i(126, 41, 84), std::nullopt}))
+                             : tube_44k();
+}
+
+/// Held at its z = 0 end, 1e-3 mN along x on every vertex, mass damping 2/s.
+void hold_base_and_push_along_x(const LinkedVolume& volume, DynamicsSettings& settings) {
+  settings.mass_damping_per_s = 2.0;
+  settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
+  const double z0 = volume.grid().origin_mm.z();
+  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
+    if (volume.vertex_position_mm(v).z() < z0 + 1e-9) settings.fixed_vertices.push_back(v);
+    settings.external_force_mN[3 * v] = 1e-3;
+  }
+}
+
+/// The slit between the cell layers y = 20 and 21, x < 4 + 2 step, upper half (z >= 25), where
+/// still linked.
+std::vector<CellFace> tube_slit(const LinkedVolume& volume, int step) {
+  std::vector<CellFace> faces;
+  for (CellId c = 0; c < volume.cell_count(); ++c) {
+    const Vec3i v = volume.cell_voxel(c);
+    if (v.y() == 20 && v.x() < 4 + 2 * step && v.z() >= 25 && volume.linked(c, 3)) faces.push_back({c, 3});
+  }
+  return faces;
+}
+
 // The step's system on the 44k tube (2 kPa tension in every cell, a small smooth displacement):
 // one product cell by cell (CorotatedSystemOperator) against the same matrix assembled as block
 // CSR, in float and double, and the operator's block diagonal. Three rounds; prints only.
@@ -108,9 +140,7 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSystemProducts) {
 
 TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   keep_freed_memory_for_reuse();  // as the CLI and the studio do
-  TissueModel model = tube_44k();
-  if (const char* shape = std::getenv("CLEAVE_BENCH_SHAPE"); shape != nullptr && std::string(shape) == "abdomen")
-    model = make_tissue_model("abdomen", make_builtin_shape("abdomen", {Vec3i(126, 41, 84), std::nullopt}));
+  TissueModel model = benchmark_model();
   LinkedVolume& volume = model.volume;
   DynamicsSettings settings;
   const char* solver = std::getenv("CLEAVE_BENCH_SOLVER");
@@ -118,15 +148,9 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   const char* steps_text = std::getenv("CLEAVE_BENCH_STEPS");
   const int steps = steps_text != nullptr ? std::atoi(steps_text) : 20;
   if (const char* tol = std::getenv("CLEAVE_BENCH_STEP_TOLERANCE"); tol != nullptr) settings.step_tolerance = std::atof(tol);
-  settings.mass_damping_per_s = 2.0;
   if (const char* budget = std::getenv("CLEAVE_BENCH_ITERATIONS_PER_STEP"); budget != nullptr)
     settings.iterations_per_step = std::atoi(budget);
-  settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
-  const double z0 = volume.grid().origin_mm.z();
-  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
-    if (volume.vertex_position_mm(v).z() < z0 + 1e-9) settings.fixed_vertices.push_back(v);
-    settings.external_force_mN[3 * v] = 1e-3;
-  }
+  hold_base_and_push_along_x(volume, settings);
   if (const char* free = std::getenv("CLEAVE_BENCH_MATRIX_FREE"); free != nullptr) settings.matrix_free = std::atoi(free) != 0;
   std::vector<Vec6> stress;
   if (const char* kpa = std::getenv("CLEAVE_BENCH_STRESS_KPA"); kpa != nullptr) {
@@ -140,14 +164,7 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
   std::vector<double> ms, with_cut_ms;
   for (int i = 0; i < steps; ++i) {
     const auto cut_start = Clock::now();
-    if (i < cut_steps) {  // the slit between the cell layers y = 20 and 21, x < 4 + 2 i, upper half
-      std::vector<CellFace> faces;
-      for (CellId c = 0; c < volume.cell_count(); ++c) {
-        const Vec3i v = volume.cell_voxel(c);
-        if (v.y() == 20 && v.x() < 4 + 2 * i && v.z() >= 25 && volume.linked(c, 3)) faces.push_back({c, 3});
-      }
-      sim.topology_changed(volume.cut_links(faces));
-    }
+    if (i < cut_steps) sim.topology_changed(volume.cut_links(tube_slit(volume, i)));
     const double cut_ms = std::chrono::duration<double, std::milli>(Clock::now() - cut_start).count();
     const auto t = Clock::now();
     const std::clock_t cpu = std::clock();
@@ -171,20 +188,12 @@ TEST(DynamicsBenchmark, DISABLED_Tube44kSteps) {
 
 TEST(DynamicsBenchmark, DISABLED_BudgetAccuracy) {
   keep_freed_memory_for_reuse();
-  const char* shape = std::getenv("CLEAVE_BENCH_SHAPE");
-  const bool abdomen = shape != nullptr && std::string(shape) == "abdomen";
-  TissueModel budget_model =
-      abdomen ? make_tissue_model("abdomen", make_builtin_shape("abdomen", {Vec3i(126, 41, 84), std::nullopt})) : tube_44k();
+  const bool abdomen = abdomen_requested();
+  TissueModel budget_model = benchmark_model();
   TissueModel exact_model = budget_model;
   const LinkedVolume& volume = budget_model.volume;
   DynamicsSettings settings;
-  settings.mass_damping_per_s = 2.0;
-  settings.external_force_mN = Vector::Zero(3 * volume.vertex_count());
-  const double z0 = volume.grid().origin_mm.z();
-  for (VertexId v = 0; v < volume.vertex_count(); ++v) {
-    if (volume.vertex_position_mm(v).z() < z0 + 1e-9) settings.fixed_vertices.push_back(v);
-    settings.external_force_mN[3 * v] = 1e-3;
-  }
+  hold_base_and_push_along_x(volume, settings);
   Vec6 tension = Vec6::Zero();
   tension[0] = tension[1] = 2.0;
   const std::vector<Vec6> stress(static_cast<std::size_t>(volume.cell_count()), tension);
@@ -200,12 +209,13 @@ TEST(DynamicsBenchmark, DISABLED_BudgetAccuracy) {
     if (i < kCutSteps)
       for (TissueModel* m : {&budget_model, &exact_model}) {
         std::vector<CellFace> faces;
-        const Face face = abdomen ? 1 : 3;
-        for (CellId c = 0; c < m->volume.cell_count(); ++c) {
-          const Vec3i v = m->volume.cell_voxel(c);
-          const bool on_slit = abdomen ? v.x() == 60 && v.y() >= 20 && v.z() > 5 && v.z() < 10 + 4 * i
-                                       : v.y() == 20 && v.x() < 4 + 2 * i && v.z() >= 25;
-          if (on_slit && m->volume.linked(c, face)) faces.push_back({c, face});
+        if (abdomen) {  // between the cell layers x = 60 and 61, y >= 20, 5 < z < 10 + 4 i
+          for (CellId c = 0; c < m->volume.cell_count(); ++c) {
+            const Vec3i v = m->volume.cell_voxel(c);
+            if (v.x() == 60 && v.y() >= 20 && v.z() > 5 && v.z() < 10 + 4 * i && m->volume.linked(c, 1)) faces.push_back({c, 1});
+          }
+        } else {
+          faces = tube_slit(m->volume, i);
         }
         (m == &budget_model ? fast : exact).topology_changed(m->volume.cut_links(faces));
       }

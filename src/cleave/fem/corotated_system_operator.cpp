@@ -56,8 +56,7 @@ void CorotatedSystemOperator::set_topology(const LinkedVolume& volume, const Ele
   material_ = material_slot_per_cell(table, volume);
   corner_slots_ = vertex_corner_slots(volume, 24);  // per_cell: 24 values per cell
   rotations_ = {};
-  cell_ranges_.clear();  // listed again by set_state for the new cells and vertices
-  vertex_held_.clear();
+  fixed_seen_.clear();  // set_state lists the fixed dofs and held cells of the new topology
   // The element matrices in corner modes, for the AVX-512 passes (none: the portable pass).
   stiffness_modes_.clear();
   stress_modes_.reset();
@@ -114,7 +113,7 @@ void CorotatedSystemOperator::set_state(std::span<const Mat3> rotations, std::sp
   rotations_ = rotations;
   with_tension_ = !tension_kPa.empty();
   fixed_ = &fixed;
-  if (fixed != fixed_seen_ || cell_ranges_.empty()) {  // a step keeps its fixed dofs: listed once
+  if (fixed != fixed_seen_) {  // a step keeps its fixed dofs: listed once
     fixed_seen_ = fixed;
     fixed_rows_.clear();
     for (std::size_t i = 0; i < dofs; ++i)
@@ -178,16 +177,12 @@ void CorotatedSystemOperator::list_held_cells() {
     const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
     return std::any_of(corners.begin(), corners.end(), [&](VertexId v) { return vertex_held_[static_cast<std::size_t>(v)] == 0; });
   };
-  for (std::size_t c = 0; c < cells;) {
-    if (!computed(c)) {
-      ++c;
-      continue;
-    }
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (!computed(c)) continue;
     const std::size_t begin = c;
-    while (c < cells && c - begin < static_cast<std::size_t>(kCellsPerTask) && computed(c)) ++c;
-    cell_ranges_.emplace_back(begin, c);
+    while (c + 1 < cells && c + 1 - begin < static_cast<std::size_t>(kCellsPerTask) && computed(c + 1)) ++c;
+    cell_ranges_.emplace_back(begin, c + 1);
   }
-  if (cell_ranges_.empty()) cell_ranges_.emplace_back(0, 0);  // listed (set_state lists only when empty or changed)
 }
 
 std::size_t CorotatedSystemOperator::computed_cells() const {
@@ -449,13 +444,14 @@ void CorotatedSystemOperator::split_corner_diagonals() {
 }
 
 std::vector<Mat3> CorotatedSystemOperator::inverse_diagonal_blocks() const {
+  if (rotations_.empty() && !material_.empty()) throw InputError("corotated system: set_state must come before its block diagonal");
   const auto vertices = static_cast<std::size_t>(corner_slots_.start.size() - 1);
   const bool split = !corner_diagonal_.empty();
   std::vector<Mat3> out(vertices);
   tbb::parallel_for(tbb::blocked_range<std::size_t>(0, vertices, static_cast<std::size_t>(kVerticesPerTask)),
                     [&](const tbb::blocked_range<std::size_t>& r) {
                       for (std::size_t v = r.begin(); v < r.end(); ++v) {
-                        if (!vertex_held_.empty() && vertex_held_[v] != 0) {  // identity rows
+                        if (vertex_held_[v] != 0) {  // identity rows
                           out[v] = Mat3::Identity();
                           continue;
                         }
