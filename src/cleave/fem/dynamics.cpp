@@ -28,8 +28,8 @@ namespace {
 /// never lowered, and includes the 15 % safety factor; one damped Jacobi step amplifies only modes
 /// above 1.25 times it): the 44k tube's step after each cut 38.0-39.3 -> 35.3-37.3 ms (harness,
 /// alternating, 3 pairs). Over the accuracy harness's 14 cuts (DISABLED_BudgetAccuracy) the bounds
-/// came out 2-3 % lower and the motion as close to the solved one (tube 1.16e-2 against 1.17e-2,
-/// abdomen 3.46e-2 against 3.44e-2).
+/// came out 2-3 % lower and the motion as close to the solved one (medians: tube 1.18e-2 against
+/// 1.17e-2, abdomen 3.46e-2 against 3.44e-2).
 MultigridOptions real_time_multigrid_options() {
   MultigridOptions options;
   options.smoother.degree = 1;
