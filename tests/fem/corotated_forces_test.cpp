@@ -1,9 +1,10 @@
 // The cells' corotated forces (fem/corotated_forces.hpp): the AVX-512 mode pass equals the dense
-// pass, each cell's forces balance, a rigid motion of a stress-free body has none, and sizes
-// that do not fit are refused.
+// pass, each cell's forces balance, a rigid motion of a stress-free body has none, a pass over
+// cell ranges writes those cells only, and sizes that do not fit are refused.
 #include <gtest/gtest.h>
 
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/fem/corotated_forces.hpp"
@@ -102,6 +103,49 @@ TEST(CorotatedForcePass, SizesThatDoNotFitAreRefused) {
     ADD_FAILURE() << "3 stresses were taken";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("3 stresses"), std::string::npos) << e.what();
+  }
+}
+
+// Over cell ranges, the pass writes exactly the listed cells' values (those of the whole pass,
+// bit for bit) and leaves every other cell's as they were; ranges that do not fit are refused.
+TEST(CorotatedForcePass, OverCellRangesOnlyTheListedCellsAreComputed) {
+  const Box box;
+  CorotatedForcePass pass;
+  pass.set_topology(box.model.volume, box.table);
+  const auto cells = static_cast<std::size_t>(box.model.volume.cell_count());
+  const std::vector<std::pair<std::size_t, std::size_t>> ranges = {{0, 3}, {7, 7}, {10, 31}, {cells - 4, cells}};
+  for (const bool mode : {true, false}) {
+    if (mode && !pass.mode_pass()) continue;
+    pass.set_mode_pass(mode);
+    SCOPED_TRACE(mode ? "mode pass" : "dense pass");
+    std::vector<double> whole;
+    pass.per_cell(box.rotations, box.stress, box.u, whole);
+    constexpr double kUntouched = -7.25;
+    std::vector<double> partial(24 * cells, kUntouched);
+    pass.per_cell(box.rotations, box.stress, box.u, ranges, partial);
+    std::vector<std::uint8_t> listed(cells, 0);
+    for (const auto& [begin, end] : ranges)
+      for (std::size_t c = begin; c < end; ++c) listed[c] = 1;
+    for (std::size_t c = 0; c < cells; ++c)
+      for (std::size_t k = 0; k < 24; ++k)
+        EXPECT_EQ(partial[24 * c + k], listed[c] ? whole[24 * c + k] : kUntouched) << "cell " << c << " value " << k;
+  }
+  std::vector<double> short_buffer(24 * cells - 1, 0.0);
+  try {
+    pass.per_cell(box.rotations, box.stress, box.u, ranges, short_buffer);
+    ADD_FAILURE() << "a buffer one value short was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("corotated forces over cell ranges: {} values for {} cells; expected 24 per cell",
+                                                  24 * cells - 1, cells));
+  }
+  std::vector<double> buffer(24 * cells, 0.0);
+  const std::vector<std::pair<std::size_t, std::size_t>> past_the_end = {{cells - 2, cells + 1}};
+  try {
+    pass.per_cell(box.rotations, box.stress, box.u, past_the_end, buffer);
+    ADD_FAILURE() << "a range past the last cell was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("corotated forces over cell ranges: range [{}, {}) outside the {} cells", cells - 2,
+                                                  cells + 1, cells));
   }
 }
 

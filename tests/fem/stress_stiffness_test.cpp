@@ -12,6 +12,7 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <fmt/format.h>
 
 #include "cleave/core/error.hpp"
 #include "cleave/fem/corotated_cells_avx512.hpp"
@@ -187,6 +188,59 @@ TEST(StressStiffness, ACellCarriesItsResidualStressPlusTheElasticStressOfItsStre
   // Stress free at rest: no tension.
   cell_rotations_and_tension(volume, table, {}, Vector::Zero(u.size()), rotations, tension);
   for (const Vec6& t : tension) EXPECT_EQ(t, Vec6::Zero());
+}
+
+// Over cell ranges: the listed cells' rotations and tensions are those of the whole pass (to
+// rounding; mixed and definite stresses alike), every other cell's stay as they were; outputs not
+// sized to the cells and ranges past them are refused.
+TEST(StressStiffness, RotationsAndTensionOverCellRangesComputeOnlyThoseCells) {
+  const TissueModel model = test::make_box_model({6, 5, 4}, 1.0, 50.0, 0.4);
+  const LinkedVolume& volume = model.volume;
+  const ElementTable table = make_element_table(model);
+  Vector u = test::turned_displacement(volume);
+  for (Eigen::Index i = 0; i < u.size(); ++i) u[i] += 0.04 * std::sin(0.9 * static_cast<double>(i));
+  const auto cells = static_cast<std::size_t>(volume.cell_count());
+  std::vector<Vec6> residual(cells);
+  for (std::size_t c = 0; c < cells; ++c) residual[c] << 4.0 + static_cast<double>(c % 5), c % 2 == 0 ? -3.0 : 2.0, 0.0, 1.0, 0.0, 0.5;
+  std::vector<Mat3> whole_rotations;
+  std::vector<Vec6> whole_tension;
+  cell_rotations_and_tension(volume, table, residual, u, whole_rotations, whole_tension);
+  const std::vector<std::pair<std::size_t, std::size_t>> ranges = {{1, 9}, {20, 21}, {40, cells}};
+  const Mat3 kept_rotation = 2.0 * Mat3::Identity();
+  const Vec6 kept_tension = Vec6::Constant(-1.0);
+  std::vector<Mat3> rotations(cells, kept_rotation);
+  std::vector<Vec6> tension(cells, kept_tension);
+  cell_rotations_and_tension(volume, table, residual, u, ranges, rotations, tension);
+  std::vector<std::uint8_t> listed(cells, 0);
+  for (const auto& [begin, end] : ranges)
+    for (std::size_t c = begin; c < end; ++c) listed[c] = 1;
+  for (std::size_t c = 0; c < cells; ++c) {
+    if (!listed[c]) {
+      EXPECT_EQ(rotations[c], kept_rotation) << "cell " << c;
+      EXPECT_EQ(tension[c], kept_tension) << "cell " << c;
+      continue;
+    }
+    // Cells share SIMD lanes with others (polar factors, mixed tensile parts) until all of a
+    // batch settle: other companions, other last bits.
+    EXPECT_LT((rotations[c] - whole_rotations[c]).norm(), 1e-13) << "cell " << c;
+    EXPECT_LT((tension[c] - whole_tension[c]).norm(), 1e-12 * whole_tension[c].norm() + 1e-15) << "cell " << c;
+  }
+  EXPECT_GT(std::count_if(whole_tension.begin(), whole_tension.end(), [](const Vec6& t) { return t.norm() > 1.0; }), 0);
+  std::vector<Vec6> short_tension(cells - 1);
+  try {
+    cell_rotations_and_tension(volume, table, residual, u, ranges, rotations, short_tension);
+    ADD_FAILURE() << "a tension list one cell short was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("rotations and tension over cell ranges: {} rotations and {} tensions for {} cells; "
+                                                  "expected one each per cell", cells, cells - 1, cells));
+  }
+  const std::vector<std::pair<std::size_t, std::size_t>> reversed = {{5, 2}};
+  try {
+    cell_rotations_and_tension(volume, table, residual, u, reversed, rotations, tension);
+    ADD_FAILURE() << "a reversed range was taken";
+  } catch (const InputError& e) {
+    EXPECT_EQ(std::string(e.what()), fmt::format("rotations and tension over cell ranges: range [5, 2) outside the {} cells", cells));
+  }
 }
 
 /// The bench's prescribed biaxial stress: `along_kPa` around the z axis through the box centre,

@@ -43,8 +43,7 @@ void CorotatedForcePass::set_mode_pass(bool on) {
   mode_pass_ = on;
 }
 
-void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
-                                  std::vector<double>& out) const {
+void CorotatedForcePass::check_sizes(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm) const {
   if (volume_ == nullptr) throw InputError("corotated forces: set_topology must come before a pass");
   const std::size_t cells = material_.size();
   if (rotations.size() != cells || (!stress_kPa.empty() && stress_kPa.size() != cells) ||
@@ -52,44 +51,64 @@ void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<con
     throw InputError(fmt::format("corotated forces: {} rotations, {} stresses and {} displacement values; expected {} cells "
                                  "(stresses: or none) and {} values",
                                  rotations.size(), stress_kPa.size(), x_mm.size(), cells, 3 * volume_->vertex_count()));
-  out.resize(24 * cells);
-  if (!mode_pass_ || cells == 0) {
-    dense_pass(rotations, stress_kPa, x_mm, out);
-    return;
-  }
-  static_assert(sizeof(Mat3) == 9 * sizeof(double) && sizeof(Vec6) == 6 * sizeof(double));
-  CorotatedForcesInput in;
-  in.x = x_mm.data();
-  in.corners = volume_->cell_vertices(0).data();
-  in.rotation = rotations.front().data();
-  in.material = material_.data();
-  in.stiffness_modes = stiffness_modes_.data();
-  in.cell_size_mm = table_->cell_size_mm;
-  in.stress_divergence = stress_divergence_.data();
-  in.stress = stress_kPa.empty() ? nullptr : stress_kPa.front().data();
-  in.per_cell = out.data();
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask),
-                    [&](const tbb::blocked_range<std::size_t>& r) { corotated_forces_avx512(in, r.begin(), r.end()); });
 }
 
-void CorotatedForcePass::dense_pass(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
-                                    std::vector<double>& out) const {
-  const double h = table_->cell_size_mm;
-  tbb::parallel_for(tbb::blocked_range<CellId>(0, volume_->cell_count(), kCellsPerTask), [&](const tbb::blocked_range<CellId>& r) {
-    for (CellId c = r.begin(); c != r.end(); ++c) {
-      const auto ci = static_cast<std::size_t>(c);
-      const Mat3& rot = rotations[ci];
-      const Vec24 d = corotated_displacement(cell_displacement(*volume_, c, x_mm), rot, h);
-      // lazyProduct: unrolled in registers, not a GEMV call per cell.
-      Vec24 local = table_->per_material[material_[ci]].stiffness.lazyProduct(d);
-      if (!stress_kPa.empty()) local += table_->stress_divergence.lazyProduct(stress_kPa[ci]);
-      double* to = out.data() + 24 * ci;
-      for (int a = 0; a < kCornerCount; ++a) {
-        const Vec3 world = rot * local.segment<3>(3 * a);
-        for (int i = 0; i < 3; ++i) to[8 * i + a] = world[i];
-      }
-    }
+void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
+                                  std::vector<double>& out) const {
+  check_sizes(rotations, stress_kPa, x_mm);
+  const std::size_t cells = material_.size();
+  out.resize(24 * cells);
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cells, kCellsPerTask), [&](const tbb::blocked_range<std::size_t>& r) {
+    cells_in_range(rotations, stress_kPa, x_mm, r.begin(), r.end(), out);
   });
+}
+
+void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
+                                  std::span<const std::pair<std::size_t, std::size_t>> cell_ranges, std::vector<double>& out) const {
+  check_sizes(rotations, stress_kPa, x_mm);
+  const std::size_t cells = material_.size();
+  if (out.size() != 24 * cells)
+    throw InputError(fmt::format("corotated forces over cell ranges: {} values for {} cells; expected 24 per cell", out.size(), cells));
+  for (const auto& [begin, end] : cell_ranges)
+    if (begin > end || end > cells)
+      throw InputError(fmt::format("corotated forces over cell ranges: range [{}, {}) outside the {} cells", begin, end, cells));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k < r.end(); ++k) cells_in_range(rotations, stress_kPa, x_mm, cell_ranges[k].first, cell_ranges[k].second, out);
+  });
+}
+
+void CorotatedForcePass::cells_in_range(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
+                                        std::size_t begin, std::size_t end, std::vector<double>& out) const {
+  if (begin >= end) return;
+  if (mode_pass_) {
+    static_assert(sizeof(Mat3) == 9 * sizeof(double) && sizeof(Vec6) == 6 * sizeof(double));
+    CorotatedForcesInput in;
+    in.x = x_mm.data();
+    in.corners = volume_->cell_vertices(0).data();
+    in.rotation = rotations.front().data();
+    in.material = material_.data();
+    in.stiffness_modes = stiffness_modes_.data();
+    in.cell_size_mm = table_->cell_size_mm;
+    in.stress_divergence = stress_divergence_.data();
+    in.stress = stress_kPa.empty() ? nullptr : stress_kPa.front().data();
+    in.per_cell = out.data();
+    corotated_forces_avx512(in, begin, end);
+    return;
+  }
+  const double h = table_->cell_size_mm;
+  for (auto c = static_cast<CellId>(begin); c != static_cast<CellId>(end); ++c) {
+    const auto ci = static_cast<std::size_t>(c);
+    const Mat3& rot = rotations[ci];
+    const Vec24 d = corotated_displacement(cell_displacement(*volume_, c, x_mm), rot, h);
+    // lazyProduct: unrolled in registers, not a GEMV call per cell.
+    Vec24 local = table_->per_material[material_[ci]].stiffness.lazyProduct(d);
+    if (!stress_kPa.empty()) local += table_->stress_divergence.lazyProduct(stress_kPa[ci]);
+    double* to = out.data() + 24 * ci;
+    for (int a = 0; a < kCornerCount; ++a) {
+      const Vec3 world = rot * local.segment<3>(3 * a);
+      for (int i = 0; i < 3; ++i) to[8 * i + a] = world[i];
+    }
+  }
 }
 
 }  // namespace cleave

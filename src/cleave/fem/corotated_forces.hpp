@@ -15,6 +15,7 @@
 #include <array>
 #include <cstdint>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "cleave/fem/element_table.hpp"
@@ -32,6 +33,10 @@ class CorotatedForcePass {
   /// do not fit the topology.
   void per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
                 std::vector<double>& per_cell) const;
+  /// The same for the cells of `cell_ranges` ([begin, end) pairs) only; the other cells' 24
+  /// values stay as they were (per_cell must already hold 24 per cell: InputError otherwise).
+  void per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
+                std::span<const std::pair<std::size_t, std::size_t>> cell_ranges, std::vector<double>& per_cell) const;
 
   /// The AVX-512 mode pass (on where it can run); off: the dense pass. Throws InputError when
   /// asked for where it cannot run.
@@ -39,7 +44,11 @@ class CorotatedForcePass {
   bool mode_pass() const { return mode_pass_; }
 
  private:
-  void dense_pass(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm, std::vector<double>& out) const;
+  /// Throws InputError when the sizes do not fit the topology.
+  void check_sizes(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm) const;
+  /// Cells [begin, end) into out (24 per cell).
+  void cells_in_range(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm, std::size_t begin,
+                      std::size_t end, std::vector<double>& out) const;
 
   const LinkedVolume* volume_ = nullptr;
   const ElementTable* table_ = nullptr;

@@ -27,6 +27,7 @@
 #include <cstdint>
 #include <optional>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "cleave/fem/corotated_cells_avx512.hpp"
@@ -73,6 +74,9 @@ class CorotatedSystemOperator final : public VertexOperator {
   const VertexCornerSlots& corner_slots() const { return corner_slots_; }
   /// Cells the products compute (set_state's): those with a corner whose dofs are not all fixed.
   std::size_t computed_cells() const;
+  /// The same cells as [begin, end) ranges, for the last set_state's topology and fixed flags
+  /// (the cells left out feed identity rows only; set_topology does not clear the list).
+  const std::vector<std::pair<std::size_t, std::size_t>>& computed_cell_ranges() const { return cell_ranges_; }
 
   /// The cell passes in AVX-512 (float: two cells per register; double: one)
   /// (fem/corotated_cells_avx512.hpp): on by default where the CPU has it. Throws InputError when

@@ -101,6 +101,7 @@ void Dynamics::rebuild_topology(const CutReport* cut) {
     ensure_pattern();
   }
   any_fixed_ = std::any_of(fixed_.begin(), fixed_.end(), [](std::uint8_t f) { return f != 0; });
+  every_cell_next_step_ = true;
   system_operator_.set_topology(model_.volume, table_);
   force_pass_.set_topology(model_.volume, table_);
   update_rotations();
@@ -185,7 +186,7 @@ std::vector<Vec3> Dynamics::displacement_mm() const {
   return out;
 }
 
-Vector Dynamics::internal_forces(const Vector* velocity) const {
+Vector Dynamics::internal_forces(const Vector* velocity, const std::vector<std::pair<std::size_t, std::size_t>>* cell_ranges) const {
   const LinkedVolume& volume = model_.volume;
   const double beta_k = velocity != nullptr ? settings_.stiffness_damping_s : 0.0;
   // Per cell its 24 corner forces by component (8 x, 8 y, 8 z), the layout of the operator's
@@ -200,7 +201,10 @@ Vector Dynamics::internal_forces(const Vector* velocity) const {
     });
     x = &damped_displacement_;
   }
-  force_pass_.per_cell(rotations_, stress_kPa_, *x, force_per_cell_);
+  if (cell_ranges != nullptr && force_per_cell_.size() == 24 * static_cast<std::size_t>(volume.cell_count()))
+    force_pass_.per_cell(rotations_, stress_kPa_, *x, *cell_ranges, force_per_cell_);
+  else
+    force_pass_.per_cell(rotations_, stress_kPa_, *x, force_per_cell_);
   // Summed per vertex over its corners (in parallel, without write conflicts).
   const VertexCornerSlots& slots = system_operator_.corner_slots();
   Vector f(u_.size());
@@ -349,10 +353,27 @@ SolveReport Dynamics::step(double dt) {
   // A stress-free body keeps the classic corotational step: its stresses come from its own
   // deformation, and the tensile part alone would make bending oscillations drift in energy
   // (5.9 % over 1000 undamped steps of the cantilever instead of < 1 %).
-  if (settings_.stress_stiffness && !stress_kPa_.empty())
-    cell_rotations_and_tension(model_.volume, table_, stress_kPa_, u_, rotations_, tension_kPa_);
-  else
+  // Cells held at every corner (the operator's list, the same fixed flags and topology as its
+  // last state) keep their rotation, tension and forces: only held dofs' rows read them.
+  const auto cells = static_cast<std::size_t>(model_.volume.cell_count());
+  const std::vector<std::pair<std::size_t, std::size_t>>* computed =
+      settings_.matrix_free && !every_cell_next_step_ && rotations_.size() == cells && tension_kPa_.size() == cells
+          ? &system_operator_.computed_cell_ranges()
+          : nullptr;
+  if (settings_.stress_stiffness && !stress_kPa_.empty()) {
+    if (computed != nullptr)
+      cell_rotations_and_tension(model_.volume, table_, stress_kPa_, u_, *computed, rotations_, tension_kPa_);
+    else
+      cell_rotations_and_tension(model_.volume, table_, stress_kPa_, u_, rotations_, tension_kPa_);
+  } else {
+    computed = nullptr;
     update_rotations();
+  }
+  cells_in_last_step_ = cells;
+  if (computed != nullptr) {
+    cells_in_last_step_ = 0;
+    for (const auto& [begin, end] : *computed) cells_in_last_step_ += end - begin;
+  }
   // M [(1 - alpha_inertia) a(n+1) + alpha_inertia a(n)] + w [D v(n+1) + f_int(n+1)]
   //   + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - alpha_forces,
   // with f_int(n+1) ~ f_int(n) + (K_R + K_sigma) du (R frozen over the step; K_sigma: how the
@@ -374,7 +395,7 @@ SolveReport Dynamics::step(double dt) {
     }
   });
   // f_int + beta_k K_R v_damped in one pass over the cells.
-  Vector rhs = internal_forces(&damped_velocity);
+  Vector rhs = internal_forces(&damped_velocity, computed);
   // rhs = f_ext - f_int + M inertia - alpha_m M v_damped; the Newmark predictor du, or no
   // increment where that is closer (the solver's zero_start_when_better). Fixed dofs are held at
   // zero: their rows are identity rows with a zero right-hand side.
@@ -405,7 +426,10 @@ SolveReport Dynamics::step(double dt) {
   } else {
     // The system applied cell by cell: its state once per step, for the operator's update or a
     // rebuild from the assembled blocks alike.
-    if (settings_.matrix_free) system_operator_.set_state(rotations_, tension_kPa_, c_stiff, w, c_mass, mass_, fixed_);
+    if (settings_.matrix_free) {
+      system_operator_.set_state(rotations_, tension_kPa_, c_stiff, w, c_mass, mass_, fixed_);
+      every_cell_next_step_ = false;
+    }
     if (!(settings_.matrix_free && hand_operator_to_solver(c_mass))) {
       ensure_pattern();
       assemble_system(c_stiff, w, c_mass);

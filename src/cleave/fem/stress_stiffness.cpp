@@ -1,12 +1,14 @@
 #include "cleave/fem/stress_stiffness.hpp"
 
 #include <Eigen/Eigenvalues>
+#include <fmt/format.h>
 #include <tbb/blocked_range.h>
 #include <tbb/parallel_for.h>
 
 #include <array>
 #include <optional>
 
+#include "cleave/core/error.hpp"
 #include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/corotation.hpp"
 #include "cleave/fem/tensile_part_avx512.hpp"
@@ -66,6 +68,21 @@ class MixedCells {
   std::size_t count_ = 0;
 };
 
+/// Rotation and tensile stress of cells [begin, end) (cell_rotations_and_tension's work per task).
+void rotations_and_tension_in_range(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                                    const Vector& displacement_mm, CellId begin, CellId end, std::vector<Mat3>& rotations,
+                                    std::vector<Vec6>& tension_kPa) {
+  MixedCells mixed(tension_kPa);
+  cell_frames_in_range(volume, displacement_mm, begin, end, rotations, [&](CellId c, const Mat3& f) {
+    const auto ci = static_cast<std::size_t>(c);
+    Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, rotations[ci]);
+    if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
+    if (const std::optional<Vec6> definite = definite_tensile_part(stress)) tension_kPa[ci] = *definite;
+    else mixed.add(c, stress);
+  });
+  mixed.flush();
+}
+
 }  // namespace
 
 Vec6 tensile_part(const Vec6& stress_kPa) {
@@ -79,15 +96,24 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
   rotations.resize(cells);
   tension_kPa.resize(cells);
   tbb::parallel_for(tbb::blocked_range<CellId>(0, volume.cell_count()), [&](const tbb::blocked_range<CellId>& r) {
-    MixedCells mixed(tension_kPa);
-    cell_frames_in_range(volume, displacement_mm, r.begin(), r.end(), rotations, [&](CellId c, const Mat3& f) {
-      const auto ci = static_cast<std::size_t>(c);
-      Vec6 stress = table.of_label(volume.cell_label(c)).elasticity_kPa * corotated_strain(f, rotations[ci]);
-      if (!residual_stress_kPa.empty()) stress += residual_stress_kPa[ci];
-      if (const std::optional<Vec6> definite = definite_tensile_part(stress)) tension_kPa[ci] = *definite;
-      else mixed.add(c, stress);
-    });
-    mixed.flush();
+    rotations_and_tension_in_range(volume, table, residual_stress_kPa, displacement_mm, r.begin(), r.end(), rotations, tension_kPa);
+  });
+}
+
+void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                                const Vector& displacement_mm, std::span<const std::pair<std::size_t, std::size_t>> cell_ranges,
+                                std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa) {
+  const auto cells = static_cast<std::size_t>(volume.cell_count());
+  if (rotations.size() != cells || tension_kPa.size() != cells)
+    throw InputError(fmt::format("rotations and tension over cell ranges: {} rotations and {} tensions for {} cells; expected one "
+                                 "each per cell", rotations.size(), tension_kPa.size(), cells));
+  for (const auto& [begin, end] : cell_ranges)
+    if (begin > end || end > cells)
+      throw InputError(fmt::format("rotations and tension over cell ranges: range [{}, {}) outside the {} cells", begin, end, cells));
+  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges.size()), [&](const tbb::blocked_range<std::size_t>& r) {
+    for (std::size_t k = r.begin(); k < r.end(); ++k)
+      rotations_and_tension_in_range(volume, table, residual_stress_kPa, displacement_mm, static_cast<CellId>(cell_ranges[k].first),
+                                     static_cast<CellId>(cell_ranges[k].second), rotations, tension_kPa);
   });
 }
 

@@ -12,6 +12,7 @@
 //   cell_rotations_and_tension(volume, table, residual_kPa, u, rotations, tension);  // per cell
 //   block(a, b) += stress_stiffness_coefficient(table, tension[c], a, b) * I_3;  // mN/mm
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "cleave/fem/element_table.hpp"
@@ -28,6 +29,12 @@ Vec6 tensile_part(const Vec6& stress_kPa);
 /// none) plus D (S - I), F from `displacement_mm` (3 n_v). In parallel; both outputs are resized.
 void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
                                 const Vector& displacement_mm, std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
+/// The same for the cells of `cell_ranges` ([begin, end) pairs) only, in parallel over the
+/// ranges; the other cells' entries stay as they were (both outputs must already hold one per
+/// cell: InputError otherwise). The dynamic step leaves out the cells held at every corner.
+void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
+                                const Vector& displacement_mm, std::span<const std::pair<std::size_t, std::size_t>> cell_ranges,
+                                std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
 
 /// The coefficient of I_3 in block (a, b) of the initial-stress stiffness of a cell that carries
 /// `stress_kPa` (mN/mm): sum over the Voigt components k of stress_k G_k(a, b).
