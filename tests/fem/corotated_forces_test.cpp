@@ -113,7 +113,7 @@ TEST(CorotatedForcePass, OverCellRangesOnlyTheListedCellsAreComputed) {
   CorotatedForcePass pass;
   pass.set_topology(box.model.volume, box.table);
   const auto cells = static_cast<std::size_t>(box.model.volume.cell_count());
-  const std::vector<std::pair<std::size_t, std::size_t>> ranges = {{0, 3}, {7, 7}, {10, 31}, {cells - 4, cells}};
+  const std::vector<CellRange> ranges = {{0, 3}, {7, 7}, {10, 31}, {cells - 4, cells}};
   for (const bool mode : {true, false}) {
     if (mode && !pass.mode_pass()) continue;
     pass.set_mode_pass(mode);
@@ -139,7 +139,7 @@ TEST(CorotatedForcePass, OverCellRangesOnlyTheListedCellsAreComputed) {
                                                   24 * cells - 1, cells));
   }
   std::vector<double> buffer(24 * cells, 0.0);
-  const std::vector<std::pair<std::size_t, std::size_t>> past_the_end = {{cells - 2, cells + 1}};
+  const std::vector<CellRange> past_the_end = {{cells - 2, cells + 1}};
   try {
     pass.per_cell(box.rotations, box.stress, box.u, past_the_end, buffer);
     ADD_FAILURE() << "a range past the last cell was taken";

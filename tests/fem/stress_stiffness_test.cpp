@@ -205,7 +205,7 @@ TEST(StressStiffness, RotationsAndTensionOverCellRangesComputeOnlyThoseCells) {
   std::vector<Mat3> whole_rotations;
   std::vector<Vec6> whole_tension;
   cell_rotations_and_tension(volume, table, residual, u, whole_rotations, whole_tension);
-  const std::vector<std::pair<std::size_t, std::size_t>> ranges = {{1, 9}, {20, 21}, {40, cells}};
+  const std::vector<CellRange> ranges = {{1, 9}, {20, 21}, {40, cells}};
   const Mat3 kept_rotation = 2.0 * Mat3::Identity();
   const Vec6 kept_tension = Vec6::Constant(-1.0);
   std::vector<Mat3> rotations(cells, kept_rotation);
@@ -234,7 +234,7 @@ TEST(StressStiffness, RotationsAndTensionOverCellRangesComputeOnlyThoseCells) {
     EXPECT_EQ(std::string(e.what()), fmt::format("rotations and tension over cell ranges: {} rotations and {} tensions for {} cells; "
                                                   "expected one each per cell", cells, cells - 1, cells));
   }
-  const std::vector<std::pair<std::size_t, std::size_t>> reversed = {{5, 2}};
+  const std::vector<CellRange> reversed = {{5, 2}};
   try {
     cell_rotations_and_tension(volume, table, residual, u, reversed, rotations, tension);
     ADD_FAILURE() << "a reversed range was taken";

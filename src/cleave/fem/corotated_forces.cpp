@@ -64,17 +64,13 @@ void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<con
 }
 
 void CorotatedForcePass::per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
-                                  std::span<const std::pair<std::size_t, std::size_t>> cell_ranges, std::vector<double>& out) const {
+                                  std::span<const CellRange> cell_ranges, std::vector<double>& out) const {
   check_sizes(rotations, stress_kPa, x_mm);
   const std::size_t cells = material_.size();
   if (out.size() != 24 * cells)
     throw InputError(fmt::format("corotated forces over cell ranges: {} values for {} cells; expected 24 per cell", out.size(), cells));
-  for (const auto& [begin, end] : cell_ranges)
-    if (begin > end || end > cells)
-      throw InputError(fmt::format("corotated forces over cell ranges: range [{}, {}) outside the {} cells", begin, end, cells));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k < r.end(); ++k) cells_in_range(rotations, stress_kPa, x_mm, cell_ranges[k].first, cell_ranges[k].second, out);
-  });
+  require_ranges_within(cell_ranges, cells, "corotated forces over cell ranges");
+  for_each_cell_range(cell_ranges, [&](std::size_t begin, std::size_t end) { cells_in_range(rotations, stress_kPa, x_mm, begin, end, out); });
 }
 
 void CorotatedForcePass::cells_in_range(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,

@@ -15,9 +15,9 @@
 #include <array>
 #include <cstdint>
 #include <span>
-#include <utility>
 #include <vector>
 
+#include "cleave/fem/cell_ranges.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/grid/linked_volume.hpp"
 #include "cleave/solve/linear_solver.hpp"
@@ -36,7 +36,7 @@ class CorotatedForcePass {
   /// The same for the cells of `cell_ranges` ([begin, end) pairs) only; the other cells' 24
   /// values stay as they were (per_cell must already hold 24 per cell: InputError otherwise).
   void per_cell(std::span<const Mat3> rotations, std::span<const Vec6> stress_kPa, const Vector& x_mm,
-                std::span<const std::pair<std::size_t, std::size_t>> cell_ranges, std::vector<double>& per_cell) const;
+                std::span<const CellRange> cell_ranges, std::vector<double>& per_cell) const;
 
   /// The AVX-512 mode pass (on where it can run); off: the dense pass. Throws InputError when
   /// asked for where it cannot run.

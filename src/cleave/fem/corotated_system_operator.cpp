@@ -191,13 +191,6 @@ std::size_t CorotatedSystemOperator::computed_cells() const {
   return count;
 }
 
-template <typename F>
-void CorotatedSystemOperator::for_each_cell_range(const F& f) const {
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges_.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k < r.end(); ++k) f(cell_ranges_[k].first, cell_ranges_[k].second);
-  });
-}
-
 template <>
 const Eigen::Matrix<float, 3, 3>& CorotatedSystemOperator::rotation_of<float>(const Precision<float>& p, std::size_t cell) const {
   return p.rotation[cell];
@@ -238,7 +231,7 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
       in.stress_modes = p.stress_modes.data();
       in.tension = with_tension_ ? p.tension.front().data() : nullptr;
       in.per_cell = p.per_cell.data();
-      for_each_cell_range([&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
+      for_each_cell_range(cell_ranges_, [&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
       sum_per_vertex(p, x_in, *x, finish);
       return;
     }
@@ -253,12 +246,12 @@ void CorotatedSystemOperator::apply(const Precision<Scalar>& p, const Eigen::Mat
     in.stress_modes = p.stress_modes.data();
     in.tension = with_tension_ ? p.tension.front().data() : nullptr;
     in.per_cell = p.per_cell.data();
-    for_each_cell_range([&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
+    for_each_cell_range(cell_ranges_, [&](std::size_t begin, std::size_t end) { corotated_cells_avx512(in, begin, end); });
     sum_per_vertex(p, x_in, *x, finish);
     return;
   }
   if constexpr (std::is_same_v<Scalar, float>) form_stress_stiffness();
-  for_each_cell_range([&](std::size_t first, std::size_t last) {
+  for_each_cell_range(cell_ranges_, [&](std::size_t first, std::size_t last) {
     for (std::size_t c = first; c < last; ++c) {
       const auto& corners = volume_->cell_vertices(static_cast<CellId>(c));
       const Mat3S& rotation = rotation_of(p, c);

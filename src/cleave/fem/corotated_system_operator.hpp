@@ -27,9 +27,9 @@
 #include <cstdint>
 #include <optional>
 #include <span>
-#include <utility>
 #include <vector>
 
+#include "cleave/fem/cell_ranges.hpp"
 #include "cleave/fem/corotated_cells_avx512.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/grid/linked_volume.hpp"
@@ -76,7 +76,7 @@ class CorotatedSystemOperator final : public VertexOperator {
   std::size_t computed_cells() const;
   /// The same cells as [begin, end) ranges, for the last set_state's topology and fixed flags
   /// (the cells left out feed identity rows only; set_topology does not clear the list).
-  const std::vector<std::pair<std::size_t, std::size_t>>& computed_cell_ranges() const { return cell_ranges_; }
+  const std::vector<CellRange>& computed_cell_ranges() const { return cell_ranges_; }
 
   /// The cell passes in AVX-512 (float: two cells per register; double: one)
   /// (fem/corotated_cells_avx512.hpp): on by default where the CPU has it. Throws InputError when
@@ -176,12 +176,9 @@ class CorotatedSystemOperator final : public VertexOperator {
   /// The cells the passes compute, in ranges of at most kCellsPerTask: those with a corner that
   /// is not held (a cell held at all 8 corners feeds identity rows only; the studio's cut model
   /// has 7,520 of 45,796 so, its removed plugs and supports).
-  std::vector<std::pair<std::size_t, std::size_t>> cell_ranges_;
+  std::vector<CellRange> cell_ranges_;
   /// vertex_held_ and cell_ranges_ for the fixed flags fixed_seen_.
   void list_held_cells();
-  /// f(begin, end) over cell_ranges_, in parallel.
-  template <typename F>
-  void for_each_cell_range(const F& f) const;
   double c_mass_ = 0;  ///< c_stiff and c_stress are folded into stiffness and tension
   const Vector* mass_kg_ = nullptr;
   bool wide_cell_pass_ = avx512_cell_pass_supported();

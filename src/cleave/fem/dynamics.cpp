@@ -186,7 +186,7 @@ std::vector<Vec3> Dynamics::displacement_mm() const {
   return out;
 }
 
-Vector Dynamics::internal_forces(const Vector* velocity, const std::vector<std::pair<std::size_t, std::size_t>>* cell_ranges) const {
+Vector Dynamics::internal_forces(const Vector* velocity, const std::vector<CellRange>* cell_ranges) const {
   const LinkedVolume& volume = model_.volume;
   const double beta_k = velocity != nullptr ? settings_.stiffness_damping_s : 0.0;
   // Per cell its 24 corner forces by component (8 x, 8 y, 8 z), the layout of the operator's
@@ -356,7 +356,7 @@ SolveReport Dynamics::step(double dt) {
   // Cells held at every corner (the operator's list, the same fixed flags and topology as its
   // last state) keep their rotation, tension and forces: only held dofs' rows read them.
   const auto cells = static_cast<std::size_t>(model_.volume.cell_count());
-  const std::vector<std::pair<std::size_t, std::size_t>>* computed =
+  const std::vector<CellRange>* computed =
       settings_.matrix_free && !every_cell_next_step_ && rotations_.size() == cells && tension_kPa_.size() == cells
           ? &system_operator_.computed_cell_ranges()
           : nullptr;
@@ -369,11 +369,7 @@ SolveReport Dynamics::step(double dt) {
     computed = nullptr;
     update_rotations();
   }
-  cells_in_last_step_ = cells;
-  if (computed != nullptr) {
-    cells_in_last_step_ = 0;
-    for (const auto& [begin, end] : *computed) cells_in_last_step_ += end - begin;
-  }
+  cells_in_last_step_ = computed != nullptr ? system_operator_.computed_cells() : cells;
   // M [(1 - alpha_inertia) a(n+1) + alpha_inertia a(n)] + w [D v(n+1) + f_int(n+1)]
   //   + (1 - w) [D v(n) + f_int(n)] = f_ext, w = 1 - alpha_forces,
   // with f_int(n+1) ~ f_int(n) + (K_R + K_sigma) du (R frozen over the step; K_sigma: how the

@@ -39,7 +39,6 @@
 #include <optional>
 #include <span>
 #include <string>
-#include <utility>
 #include <vector>
 
 #include "cleave/fem/corotated_forces.hpp"
@@ -178,7 +177,7 @@ class Dynamics {
   /// `cell_ranges`: only those cells' forces are computed afresh (the others' stay as the last
   /// pass left them); null: every cell.
   Vector internal_forces(const Vector* velocity = nullptr,
-                         const std::vector<std::pair<std::size_t, std::size_t>>* cell_ranges = nullptr) const;
+                         const std::vector<CellRange>* cell_ranges = nullptr) const;
   Vector external_forces() const;
   /// system_blocks_ = c_stiff K_R + c_stress K_sigma + c_mass M in one gather (no separate K_R,
   /// no scaling pass); K_sigma from tension_kPa_.

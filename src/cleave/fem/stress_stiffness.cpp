@@ -101,19 +101,16 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
 }
 
 void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
-                                const Vector& displacement_mm, std::span<const std::pair<std::size_t, std::size_t>> cell_ranges,
+                                const Vector& displacement_mm, std::span<const CellRange> cell_ranges,
                                 std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa) {
   const auto cells = static_cast<std::size_t>(volume.cell_count());
   if (rotations.size() != cells || tension_kPa.size() != cells)
     throw InputError(fmt::format("rotations and tension over cell ranges: {} rotations and {} tensions for {} cells; expected one "
                                  "each per cell", rotations.size(), tension_kPa.size(), cells));
-  for (const auto& [begin, end] : cell_ranges)
-    if (begin > end || end > cells)
-      throw InputError(fmt::format("rotations and tension over cell ranges: range [{}, {}) outside the {} cells", begin, end, cells));
-  tbb::parallel_for(tbb::blocked_range<std::size_t>(0, cell_ranges.size()), [&](const tbb::blocked_range<std::size_t>& r) {
-    for (std::size_t k = r.begin(); k < r.end(); ++k)
-      rotations_and_tension_in_range(volume, table, residual_stress_kPa, displacement_mm, static_cast<CellId>(cell_ranges[k].first),
-                                     static_cast<CellId>(cell_ranges[k].second), rotations, tension_kPa);
+  require_ranges_within(cell_ranges, cells, "rotations and tension over cell ranges");
+  for_each_cell_range(cell_ranges, [&](std::size_t begin, std::size_t end) {
+    rotations_and_tension_in_range(volume, table, residual_stress_kPa, displacement_mm, static_cast<CellId>(begin),
+                                   static_cast<CellId>(end), rotations, tension_kPa);
   });
 }
 

@@ -12,9 +12,9 @@
 //   cell_rotations_and_tension(volume, table, residual_kPa, u, rotations, tension);  // per cell
 //   block(a, b) += stress_stiffness_coefficient(table, tension[c], a, b) * I_3;  // mN/mm
 #include <span>
-#include <utility>
 #include <vector>
 
+#include "cleave/fem/cell_ranges.hpp"
 #include "cleave/fem/element_table.hpp"
 #include "cleave/grid/linked_volume.hpp"
 #include "cleave/solve/linear_solver.hpp"
@@ -33,7 +33,7 @@ void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& 
 /// ranges; the other cells' entries stay as they were (both outputs must already hold one per
 /// cell: InputError otherwise). The dynamic step leaves out the cells held at every corner.
 void cell_rotations_and_tension(const LinkedVolume& volume, const ElementTable& table, std::span<const Vec6> residual_stress_kPa,
-                                const Vector& displacement_mm, std::span<const std::pair<std::size_t, std::size_t>> cell_ranges,
+                                const Vector& displacement_mm, std::span<const CellRange> cell_ranges,
                                 std::vector<Mat3>& rotations, std::vector<Vec6>& tension_kPa);
 
 /// The coefficient of I_3 in block (a, b) of the initial-stress stiffness of a cell that carries
